@@ -1,0 +1,66 @@
+//! The command-line interface: one file per subcommand. Flags are parsed by clap, turned
+//! into a validated configuration, and handed to the library. Errors are printed once,
+//! with their chain, and mapped to exit codes: 2 for bad input (parse errors, unreadable
+//! or invalid files), 1 for other failures.
+
+pub mod args;
+mod convert;
+mod import;
+mod info;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+pub use args::{Cli, Command};
+
+/// Exit status for bad input: parse errors, unreadable files, invalid content.
+pub const EXIT_BAD_INPUT: u8 = 2;
+/// Exit status for any other failure.
+pub const EXIT_FAILURE: u8 = 1;
+
+/// Parses the command line, runs the command and prints any error.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(code) => code,
+        Err(err) => {
+            if is_broken_pipe(&err) {
+                return ExitCode::SUCCESS;
+            }
+            eprintln!("patchtrace: {err}");
+            let mut source = err.source();
+            while let Some(s) = source {
+                eprintln!("  caused by: {s}");
+                source = s.source();
+            }
+            ExitCode::from(exit_code_for(&err))
+        }
+    }
+}
+
+/// Runs one parsed command.
+pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
+    match cli.command {
+        Command::Info(a) => info::run(a),
+        Command::Import(a) => import::run(a),
+        Command::Convert(a) => convert::run(a),
+    }
+}
+
+fn exit_code_for(err: &anyhow::Error) -> u8 {
+    if err.downcast_ref::<crate::scene::LoadError>().is_some()
+        || err.downcast_ref::<crate::scene::ParseError>().is_some()
+    {
+        EXIT_BAD_INPUT
+    } else {
+        EXIT_FAILURE
+    }
+}
+
+fn is_broken_pipe(err: &anyhow::Error) -> bool {
+    err.chain().any(|e| {
+        e.downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+    })
+}

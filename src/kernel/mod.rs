@@ -1,0 +1,39 @@
+//! Ray–patch intersection kernels, one per method. A kernel is chosen by an enum on the
+//! hot path, not a trait object (pbrt-v4's tagged dispatch).
+//!
+//! - [`subdivision`]: Dammertz 2005 §2.2–2.3 and §2.7: subdivide until the bounding box
+//!   stops shrinking in `f32`, with an `f64` twin that is the accuracy reference.
+
+pub mod subdivision;
+
+use crate::geom::Aabb;
+
+/// A hit on one patch: `t` at the entry of the final box, (u, v) the centre of the final
+/// parameter interval in the patch's own [0,1]², and the final box itself (the hit
+/// interval, Dammertz §2.3), from which secondary rays start.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PatchHit {
+    pub t: f32,
+    pub u: f32,
+    pub v: f32,
+    pub hit_box: Aabb,
+}
+
+/// Work counters of kernel calls, summed by the caller per ray and per image.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct KernelStats {
+    /// Ray–patch tests started.
+    pub patch_tests: u64,
+    /// de Casteljau splits.
+    pub splits: u64,
+    /// Ray–box tests inside the kernel.
+    pub box_tests: u64,
+}
+
+impl KernelStats {
+    pub fn add(&mut self, other: &KernelStats) {
+        self.patch_tests += other.patch_tests;
+        self.splits += other.splits;
+        self.box_tests += other.box_tests;
+    }
+}

@@ -1,0 +1,6 @@
+//! The `patchtrace` binary: all work happens in the library; this only maps the outcome to
+//! an exit status.
+
+fn main() -> std::process::ExitCode {
+    patchtrace::cli::main()
+}

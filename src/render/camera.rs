@@ -1,0 +1,103 @@
+//! The pinhole camera of the DESIGN.md contract. Rays are computed in `f64` and rounded
+//! once to `f32`.
+
+use glam::{DVec3, Vec3};
+
+use crate::geom::Ray;
+use crate::scene::Camera;
+
+/// The camera's orthonormal frame and image-plane scale, precomputed.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraRays {
+    eye: DVec3,
+    forward: DVec3,
+    right: DVec3,
+    up: DVec3,
+    scale: f64,
+    width: f64,
+    height: f64,
+}
+
+impl CameraRays {
+    pub fn new(c: &Camera) -> Self {
+        let forward = (c.look_at - c.eye).normalize();
+        let right = forward.cross(c.up).normalize();
+        let up = right.cross(forward);
+        CameraRays {
+            eye: c.eye,
+            forward,
+            right,
+            up,
+            scale: (c.fov_y.to_radians() * 0.5).tan(),
+            width: c.width as f64,
+            height: c.height as f64,
+        }
+    }
+
+    /// Origin and unit direction in `f64` for pixel (x, y) and sample offset (sx, sy).
+    pub fn ray_f64(&self, x: u32, y: u32, sx: f64, sy: f64) -> (DVec3, DVec3) {
+        let a = (2.0 * (x as f64 + sx) / self.width - 1.0) * self.scale * self.width / self.height;
+        let b = (1.0 - 2.0 * (y as f64 + sy) / self.height) * self.scale;
+        (
+            self.eye,
+            (self.forward + a * self.right + b * self.up).normalize(),
+        )
+    }
+
+    /// The ray through the centre of pixel (x, y), rounded once to `f32`.
+    pub fn ray(&self, x: u32, y: u32) -> Ray {
+        let (o, d) = self.ray_f64(x, y, 0.5, 0.5);
+        Ray::new(o.as_vec3(), d.as_vec3())
+    }
+
+    pub fn eye(&self) -> Vec3 {
+        self.eye.as_vec3()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn camera() -> Camera {
+        Camera {
+            eye: DVec3::new(0.0, -8.0, 4.5),
+            look_at: DVec3::new(0.0, 0.0, 1.2),
+            up: DVec3::Z,
+            fov_y: 40.0,
+            width: 640,
+            height: 480,
+        }
+    }
+
+    #[test]
+    fn centre_ray_looks_at_the_target() {
+        let mut c = camera();
+        c.width = 2;
+        c.height = 2;
+        let cam = CameraRays::new(&c);
+        // With 2x2 pixels, the four centre rays are symmetric about the view direction.
+        let f = (c.look_at - c.eye).normalize();
+        let sum: DVec3 = [(0, 0), (1, 0), (0, 1), (1, 1)]
+            .iter()
+            .map(|&(x, y)| cam.ray_f64(x, y, 0.5, 0.5).1)
+            .sum();
+        assert!((sum.normalize() - f).length() < 1e-12);
+    }
+
+    #[test]
+    fn corner_ray_follows_the_contract_formula() {
+        let c = camera();
+        let cam = CameraRays::new(&c);
+        let (_, d) = cam.ray_f64(0, 0, 0.0, 0.0);
+        // Top-left corner: a = -s * aspect, b = s; the angle to the vertical centre line of
+        // the image is half the vertical field of view.
+        let f = (c.look_at - c.eye).normalize();
+        let r = f.cross(c.up).normalize();
+        let u = r.cross(f);
+        let s = 20f64.to_radians().tan();
+        let expect = (f - s * 640.0 / 480.0 * r + s * u).normalize();
+        assert!((d - expect).length() < 1e-15);
+        assert!(d.dot(u) > 0.0 && d.dot(r) < 0.0);
+    }
+}

@@ -1,0 +1,4 @@
+//! Rendering: camera rays, the Whitted integrator with its effect plan, the film and image
+//! output, and statistics.
+
+pub mod camera;

@@ -1,0 +1,86 @@
+//! Choosing a reader by file type, and turning bare geometry into a scene.
+
+use std::path::Path;
+
+use super::error::LoadError;
+use super::model::{Geometry, Object, Scene, Surface};
+use super::{bpt, mesh, obj, pbrt, ron_format};
+
+/// The kinds of input file we read, by extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InputKind {
+    Ron,
+    Bpt,
+    Obj,
+    Pbrt,
+    Gltf,
+}
+
+impl InputKind {
+    pub fn of(path: &Path) -> Option<InputKind> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        Some(match ext.as_str() {
+            "ron" => InputKind::Ron,
+            "bpt" => InputKind::Bpt,
+            "obj" => InputKind::Obj,
+            "pbrt" => InputKind::Pbrt,
+            "gltf" | "glb" => InputKind::Gltf,
+            _ => return None,
+        })
+    }
+}
+
+fn unknown_kind(path: &Path) -> LoadError {
+    LoadError::invalid(
+        path,
+        "unknown file type: expected .ron (scene), .bpt, .obj, .pbrt, .gltf or .glb",
+    )
+}
+
+/// Reads a geometry file: free-form surfaces or a triangle mesh.
+pub fn load_geometry(path: &Path) -> Result<Geometry, LoadError> {
+    match InputKind::of(path).ok_or_else(|| unknown_kind(path))? {
+        InputKind::Bpt => Ok(Geometry::Surfaces(
+            bpt::read_bpt(path)?
+                .into_iter()
+                .map(Surface::bezier)
+                .collect(),
+        )),
+        InputKind::Obj => {
+            let src = super::error::read_text(path)?;
+            if obj::is_freeform(&src) {
+                Ok(Geometry::Surfaces(obj::parse_obj_freeform(path, &src)?))
+            } else {
+                Ok(Geometry::Mesh(mesh::read_obj_mesh(path)?))
+            }
+        }
+        InputKind::Pbrt => {
+            let src = super::error::read_text(path)?;
+            Ok(Geometry::Surfaces(pbrt::parse_pbrt(path, &src)?))
+        }
+        InputKind::Gltf => Ok(Geometry::Mesh(mesh::read_gltf(path)?)),
+        InputKind::Ron => Err(LoadError::invalid(
+            path,
+            "a scene cannot be used as geometry; reference its geometry files instead",
+        )),
+    }
+}
+
+/// Reads a scene: a RON scene file, or bare geometry framed by a default camera and light.
+pub fn load_scene(path: &Path) -> Result<Scene, LoadError> {
+    match InputKind::of(path).ok_or_else(|| unknown_kind(path))? {
+        InputKind::Ron => ron_format::read_scene(path),
+        _ => {
+            let geometry = load_geometry(path)?;
+            let name = path
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            Ok(Scene::framing(vec![Object {
+                name,
+                material: 0,
+                geometry,
+            }]))
+        }
+    }
+}

@@ -1,0 +1,21 @@
+//! The scene model and one reader/writer per format: our RON scene, `.bpt` Bézier patch
+//! files, Wavefront OBJ free-form surfaces, pbrt-v3 `Shape "nurbs"`, and triangle meshes
+//! (OBJ via tobj, glTF via gltf). Every reader reports errors as `file:line:col: what was
+//! expected`; every writer writes to a temporary name and renames.
+
+pub mod bpt;
+pub mod convert;
+pub mod error;
+pub mod load;
+pub mod mesh;
+pub mod model;
+pub mod obj;
+pub mod pbrt;
+pub mod ron_format;
+pub mod summary;
+pub mod text;
+pub mod write;
+
+pub use error::{LoadError, ParseError};
+pub use load::{load_geometry, load_scene};
+pub use model::*;

@@ -1,0 +1,229 @@
+//! The in-memory scene: camera, lights, materials and objects. Geometry is kept in `f64`
+//! exactly as read (after transforms); the renderer rounds it to `f32` once.
+
+use glam::{DVec3, Vec3};
+
+use crate::geom::BezierPatch;
+use crate::geom::bbox::DAabb;
+use crate::geom::nurbs::NurbsSurface;
+use crate::geom::trim::TrimLoop;
+
+/// Camera per the DESIGN.md contract.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Camera {
+    pub eye: DVec3,
+    pub look_at: DVec3,
+    pub up: DVec3,
+    /// Vertical field of view in degrees.
+    pub fov_y: f64,
+    pub width: u32,
+    pub height: u32,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Light {
+    Point {
+        position: DVec3,
+        intensity: Vec3,
+    },
+    /// `direction` points from the light into the scene.
+    Directional {
+        direction: DVec3,
+        intensity: Vec3,
+    },
+}
+
+/// Whitted material. Highlight model is Phong unless `blinn` is set.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    pub diffuse: Vec3,
+    pub specular: f32,
+    pub shininess: f32,
+    pub reflect: f32,
+    pub transmit: f32,
+    pub ior: f32,
+    pub blinn: bool,
+}
+
+impl Material {
+    pub fn default_named(name: &str) -> Self {
+        Material {
+            name: name.to_string(),
+            diffuse: Vec3::splat(0.8),
+            specular: 0.0,
+            shininess: 32.0,
+            reflect: 0.0,
+            transmit: 0.0,
+            ior: 1.5,
+            blinn: false,
+        }
+    }
+}
+
+/// A free-form surface as read: a Bézier patch or a NURBS surface, with any trim loops.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Surface {
+    pub geometry: SurfaceGeometry,
+    pub trims: Vec<TrimLoop>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum SurfaceGeometry {
+    Bezier(BezierPatch),
+    Nurbs(NurbsSurface),
+}
+
+impl Surface {
+    pub fn bezier(patch: BezierPatch) -> Self {
+        Surface {
+            geometry: SurfaceGeometry::Bezier(patch),
+            trims: Vec::new(),
+        }
+    }
+
+    pub fn transform(&mut self, m: &glam::DAffine3) {
+        match &mut self.geometry {
+            SurfaceGeometry::Bezier(p) => p.transform(m),
+            SurfaceGeometry::Nurbs(n) => n.transform(m),
+        }
+    }
+}
+
+/// An indexed triangle mesh with optional per-vertex normals.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriangleMesh {
+    pub positions: Vec<DVec3>,
+    pub normals: Vec<DVec3>,
+    pub indices: Vec<[u32; 3]>,
+}
+
+impl TriangleMesh {
+    pub fn transform(&mut self, m: &glam::DAffine3) {
+        for p in &mut self.positions {
+            *p = m.transform_point3(*p);
+        }
+        // Normals transform by the inverse transpose of the linear part.
+        let nm = m.matrix3.inverse().transpose();
+        for n in &mut self.normals {
+            *n = (nm * *n).normalize_or_zero();
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Geometry {
+    Surfaces(Vec<Surface>),
+    Mesh(TriangleMesh),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Object {
+    pub name: String,
+    /// Index into [`Scene::materials`].
+    pub material: usize,
+    pub geometry: Geometry,
+}
+
+impl Object {
+    /// The object's Bézier patches in contract order: file order, with each NURBS surface
+    /// expanded into its patches in span order, u spans fastest.
+    pub fn bezier_patches(&self) -> Vec<BezierPatch> {
+        match &self.geometry {
+            Geometry::Surfaces(surfaces) => surfaces
+                .iter()
+                .flat_map(|s| match &s.geometry {
+                    SurfaceGeometry::Bezier(p) => vec![p.clone()],
+                    SurfaceGeometry::Nurbs(n) => n.to_bezier_patches(),
+                })
+                .collect(),
+            Geometry::Mesh(_) => Vec::new(),
+        }
+    }
+
+    pub fn bounds(&self) -> DAabb {
+        match &self.geometry {
+            Geometry::Surfaces(surfaces) => surfaces
+                .iter()
+                .flat_map(|s| -> Vec<DVec3> {
+                    match &s.geometry {
+                        SurfaceGeometry::Bezier(p) => p.euclidean_points().collect(),
+                        SurfaceGeometry::Nurbs(n) => {
+                            n.points.iter().map(|p| p.truncate() / p.w).collect()
+                        }
+                    }
+                })
+                .collect(),
+            Geometry::Mesh(m) => m.positions.iter().copied().collect(),
+        }
+    }
+}
+
+/// Everything needed to render.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    pub camera: Camera,
+    pub background: Vec3,
+    /// Ambient term added to every lit surface, as a fraction of its diffuse colour.
+    pub ambient: f32,
+    /// Longest path of reflection and refraction bounces (the primary ray is depth 1).
+    pub max_depth: u32,
+    pub lights: Vec<Light>,
+    pub materials: Vec<Material>,
+    pub objects: Vec<Object>,
+}
+
+/// Default recursion limit for reflection and refraction (issue 3).
+pub const DEFAULT_MAX_DEPTH: u32 = 5;
+/// Default ambient fraction.
+pub const DEFAULT_AMBIENT: f32 = 0.1;
+
+impl Scene {
+    pub fn bounds(&self) -> DAabb {
+        self.objects
+            .iter()
+            .fold(DAabb::EMPTY, |acc, o| acc.union(&o.bounds()))
+    }
+
+    /// A scene for bare geometry: a camera that frames it from the front-left and above,
+    /// and one point light near the camera (DESIGN.md: bare geometry as a scene).
+    pub fn framing(objects: Vec<Object>) -> Scene {
+        let mut scene = Scene {
+            camera: Camera {
+                eye: DVec3::new(0.0, -5.0, 0.0),
+                look_at: DVec3::ZERO,
+                up: DVec3::Z,
+                fov_y: 40.0,
+                width: 512,
+                height: 512,
+            },
+            background: Vec3::new(0.05, 0.05, 0.08),
+            ambient: DEFAULT_AMBIENT,
+            max_depth: DEFAULT_MAX_DEPTH,
+            lights: Vec::new(),
+            materials: vec![Material::default_named("default")],
+            objects,
+        };
+        let b = scene.bounds();
+        let (center, radius) = if b.is_empty() {
+            (DVec3::ZERO, 1.0)
+        } else {
+            (b.center(), (0.5 * b.diagonal()).max(f64::MIN_POSITIVE))
+        };
+        // Distance at which a sphere of this radius fits the vertical field of view.
+        let half_fov = (scene.camera.fov_y.to_radians() * 0.5).sin();
+        let distance = radius / half_fov * 1.1;
+        let view = DVec3::new(0.35, -1.0, 0.45).normalize();
+        scene.camera.eye = center + view * distance;
+        scene.camera.look_at = center;
+        scene.lights.push(Light::Point {
+            position: center + DVec3::new(1.0, -1.0, 1.5).normalize() * distance,
+            intensity: Vec3::ONE,
+        });
+        scene
+    }
+
+    pub fn patch_count(&self) -> usize {
+        self.objects.iter().map(|o| o.bezier_patches().len()).sum()
+    }
+}
