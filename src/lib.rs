@@ -5,6 +5,10 @@
 //! → accelerator ([`accel`]) → kernels ([`kernel`]) → integrator and film ([`render`]).
 //! The command-line front end lives in [`cli`].
 
+// Numeric kernels index control nets by (i, j) in lockstep across several arrays; index
+// loops say that more plainly than zipped iterators.
+#![allow(clippy::needless_range_loop)]
+
 pub mod accel;
 pub mod cli;
 pub mod geom;

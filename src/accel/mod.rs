@@ -4,3 +4,4 @@
 //!   boxes; Dammertz §3.2), traversed nearest-first, serializable to a versioned file.
 
 pub mod bvh;
+pub mod scene;

@@ -21,6 +21,12 @@ pub enum Command {
     Import(ImportArgs),
     /// Convert NURBS surfaces to Bézier patches exactly (knot insertion) and report counts.
     Convert(ConvertArgs),
+    /// Build the BVH of a scene and write it to a file that `render --bvh` loads.
+    Bvh(BvhArgs),
+    /// Render a scene to PNG or EXR.
+    Render(RenderArgs),
+    /// Nearest hit per ray from a ray file, as CSV.
+    Trace(TraceArgs),
 }
 
 #[derive(Debug, Args)]
@@ -52,4 +58,105 @@ pub struct ConvertArgs {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+}
+
+/// Intersection kernel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum KernelChoice {
+    /// Dammertz's float-precision subdivision (§2.2–2.3, §2.7).
+    Subdivision,
+}
+
+/// Arithmetic of the kernel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum PrecisionChoice {
+    /// f32, to the precision of f32 itself: the renderer.
+    F32,
+    /// The same algorithm in f64: the accuracy reference.
+    F64,
+}
+
+/// Split direction heuristic of the subdivision kernel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum HeuristicChoice {
+    /// Split across the longer parameter direction of the control net (Dammertz §2.3.2).
+    Length,
+    /// Split by the cross-product heuristic (Dammertz §2.5.2).
+    Cross,
+}
+
+/// Options shared by every command that intersects rays.
+#[derive(Debug, Args, Clone)]
+pub struct KernelArgs {
+    /// Intersection kernel.
+    #[arg(long, value_enum, default_value_t = KernelChoice::Subdivision)]
+    pub kernel: KernelChoice,
+    /// Kernel arithmetic: f32 (renderer) or f64 (reference).
+    #[arg(long, value_enum, default_value_t = PrecisionChoice::F32)]
+    pub precision: PrecisionChoice,
+    /// Split direction heuristic.
+    #[arg(long, value_enum, default_value_t = HeuristicChoice::Length)]
+    pub heuristic: HeuristicChoice,
+    /// Mantissa distance (ulps) at which subdivision of rational patches stops
+    /// (Dammertz §2.7.2).
+    #[arg(long, value_name = "ULPS")]
+    pub rational_dist: Option<u32>,
+    /// Load the BVH from this file (written by `patchtrace bvh`) instead of building it.
+    #[arg(long, value_name = "FILE")]
+    pub bvh: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    /// Scene (.ron) or bare geometry.
+    pub scene: PathBuf,
+    /// Output image: .png (8-bit sRGB) or .exr (linear f32 RGBA).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub kernel: KernelArgs,
+    /// Ulps by which secondary ray origins are moved off the hit box (Dammertz §2.4.2).
+    #[arg(long, default_value_t = crate::kernel::secondary::DEFAULT_ULPS)]
+    pub ulps: u32,
+    /// Override the camera's image width.
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Override the camera's image height.
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Worker threads (default: all cores). The image is identical for any count.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Print statistics as JSON on stdout.
+    #[arg(long)]
+    pub stats: bool,
+    /// No progress bar.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct TraceArgs {
+    /// Scene (.ron) or bare geometry.
+    pub scene: PathBuf,
+    /// Ray file: `ox oy oz dx dy dz [tmin [tmax]]` per line.
+    #[arg(long)]
+    pub rays: PathBuf,
+    /// Write the CSV here instead of stdout.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    #[command(flatten)]
+    pub kernel: KernelArgs,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
+
+#[derive(Debug, Args)]
+pub struct BvhArgs {
+    /// Scene (.ron) or bare geometry.
+    pub scene: PathBuf,
+    /// Output BVH file.
+    #[arg(short, long)]
+    pub output: PathBuf,
 }

@@ -4,9 +4,13 @@
 //! or invalid files), 1 for other failures.
 
 pub mod args;
+mod bvh;
 mod convert;
 mod import;
 mod info;
+mod render;
+mod setup;
+pub mod trace;
 
 use std::process::ExitCode;
 
@@ -45,6 +49,9 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Info(a) => info::run(a),
         Command::Import(a) => import::run(a),
         Command::Convert(a) => convert::run(a),
+        Command::Bvh(a) => bvh::run(a),
+        Command::Render(a) => render::run(a),
+        Command::Trace(a) => trace::run(a),
     }
 }
 

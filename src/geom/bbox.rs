@@ -194,7 +194,7 @@ mod tests {
         let d = Vec3::new(0.0, 0.0, 1.0);
         let (t0, t1) = b.intersect(o, d.recip(), 0.0, f32::INFINITY).unwrap();
         assert_eq!(t0, 4.0);
-        assert!(t1 >= 6.0 && t1 < 6.0001);
+        assert!((6.0..6.0001).contains(&t1));
         assert!(b.intersect(o, d.recip(), 0.0, 3.0).is_none());
         let off = Vec3::new(2.0, 0.0, -5.0);
         assert!(b.intersect(off, d.recip(), 0.0, f32::INFINITY).is_none());

@@ -2,3 +2,8 @@
 //! output, and statistics.
 
 pub mod camera;
+pub mod film;
+pub mod integrator;
+pub mod plan;
+pub mod renderer;
+pub mod stats;

@@ -11,6 +11,7 @@ pub mod mesh;
 pub mod model;
 pub mod obj;
 pub mod pbrt;
+pub mod rays;
 pub mod ron_format;
 pub mod summary;
 pub mod text;

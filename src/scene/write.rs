@@ -37,32 +37,6 @@ pub fn temporary_name(path: &Path) -> PathBuf {
     path.with_file_name(format!(".{name}.tmp-{}", std::process::id()))
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn failed_write_leaves_nothing_behind() {
-        let dir = tempfile::tempdir().unwrap();
-        let out = dir.path().join("x.txt");
-        let err = write_atomic(&out, |w| {
-            w.write_all(b"half")?;
-            Err(std::io::Error::other("boom"))
-        });
-        assert!(err.is_err());
-        assert!(!out.exists());
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
-    }
-
-    #[test]
-    fn successful_write_lands_under_the_real_name() {
-        let dir = tempfile::tempdir().unwrap();
-        let out = dir.path().join("x.txt");
-        write_atomic(&out, |w| w.write_all(b"whole")).unwrap();
-        assert_eq!(std::fs::read(&out).unwrap(), b"whole");
-    }
-}
-
 /// Writes a scene by the output's extension: `.ron` (geometry inline), `.bpt` (all
 /// patches, non-rational only) or `.obj` (free-form Bézier patches). NURBS surfaces are
 /// written as their Bézier patches to `.bpt` and `.obj`.
@@ -100,5 +74,31 @@ pub fn write_scene_as(path: &Path, scene: &super::model::Scene) -> Result<(), Lo
             path,
             "unsupported output type: expected .ron, .bpt or .obj",
         )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn failed_write_leaves_nothing_behind() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("x.txt");
+        let err = write_atomic(&out, |w| {
+            w.write_all(b"half")?;
+            Err(std::io::Error::other("boom"))
+        });
+        assert!(err.is_err());
+        assert!(!out.exists());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+
+    #[test]
+    fn successful_write_lands_under_the_real_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("x.txt");
+        write_atomic(&out, |w| w.write_all(b"whole")).unwrap();
+        assert_eq!(std::fs::read(&out).unwrap(), b"whole");
     }
 }

@@ -1,0 +1,95 @@
+//! `patchtrace render SCENE -o OUT.png|OUT.exr`.
+
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::bail;
+use serde::Serialize;
+
+use crate::cli::args::RenderArgs;
+use crate::cli::setup::{precision, prepare, thread_pool};
+use crate::render::film::ImageFormat;
+use crate::render::integrator::{Integrator, TraceSettings};
+use crate::render::plan::EffectPlan;
+use crate::render::renderer::{progress_bar, render_image};
+use crate::render::stats::{PhaseTimes, RayReport};
+use crate::scene::LoadError;
+
+#[derive(Serialize)]
+struct RenderStats {
+    plan: EffectPlan,
+    width: u32,
+    height: u32,
+    threads: usize,
+    patches: usize,
+    rays: RayReport,
+    seconds: PhaseTimes,
+}
+
+pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
+    if ImageFormat::of(&args.output).is_none() {
+        return Err(LoadError::invalid(
+            &args.output,
+            "unsupported image type: expected .png or .exr",
+        )
+        .into());
+    }
+    if args.width == Some(0) || args.height == Some(0) {
+        bail!("--width and --height must be at least 1");
+    }
+    let pool = thread_pool(args.threads)?;
+    let mut prepared = prepare(&args.scene, &args.kernel)?;
+    let scene = &mut prepared.scene;
+    if let Some(w) = args.width {
+        scene.camera.width = w;
+    }
+    if let Some(h) = args.height {
+        scene.camera.height = h;
+    }
+    let plan = EffectPlan::for_scene(scene);
+    eprintln!("{plan}");
+    let integrator = Integrator {
+        scene,
+        geometry: &prepared.geometry,
+        settings: TraceSettings {
+            precision: precision(&args.kernel),
+            ulps: args.ulps,
+            plan,
+        },
+    };
+    let bar = progress_bar(args.quiet, "rendering");
+    let start = Instant::now();
+    let (film, tally) = pool.install(|| render_image(&integrator, &bar));
+    let render_seconds = start.elapsed().as_secs_f64();
+    let start = Instant::now();
+    film.write(&args.output)?;
+    let write_seconds = start.elapsed().as_secs_f64();
+    if args.stats {
+        let stats = RenderStats {
+            plan,
+            width: film.width,
+            height: film.height,
+            threads: pool.current_num_threads(),
+            patches: prepared.geometry.patch_count(),
+            rays: tally.report(),
+            seconds: PhaseTimes {
+                load: prepared.load_seconds,
+                prepare: prepared.prepare_seconds,
+                render: render_seconds,
+                write: write_seconds,
+            },
+        };
+        println!("{}", serde_json::to_string_pretty(&stats)?);
+    }
+    if !args.quiet {
+        eprintln!(
+            "wrote {} ({}x{}, {} rays, {:.3} s)",
+            args.output.display(),
+            film.width,
+            film.height,
+            tally.total(),
+            render_seconds
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}

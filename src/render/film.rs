@@ -1,0 +1,102 @@
+//! The film: linear RGBA pixels, written as 8-bit sRGB PNG or linear f32 RGBA EXR. Alpha is
+//! 1 where the primary ray hit geometry and 0 on the background, so `diff` can count
+//! silhouette (coverage) mismatches.
+
+use std::path::Path;
+
+use glam::Vec4;
+
+use crate::scene::LoadError;
+use crate::scene::write::{temporary_name, write_atomic};
+
+pub struct Film {
+    pub width: u32,
+    pub height: u32,
+    /// Row-major, row 0 at the top.
+    pub pixels: Vec<Vec4>,
+}
+
+/// Output image formats, by extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFormat {
+    Png,
+    Exr,
+}
+
+impl ImageFormat {
+    pub fn of(path: &Path) -> Option<ImageFormat> {
+        match path.extension()?.to_str()?.to_ascii_lowercase().as_str() {
+            "png" => Some(ImageFormat::Png),
+            "exr" => Some(ImageFormat::Exr),
+            _ => None,
+        }
+    }
+}
+
+/// The sRGB transfer function (IEC 61966-2-1).
+pub fn linear_to_srgb(x: f32) -> f32 {
+    let x = x.clamp(0.0, 1.0);
+    if x <= 0.003_130_8 {
+        12.92 * x
+    } else {
+        1.055 * x.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+impl Film {
+    /// Encodes 8-bit sRGB RGBA.
+    pub fn to_srgb8(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(self.pixels.len() * 4);
+        for p in &self.pixels {
+            for c in [p.x, p.y, p.z] {
+                out.push((linear_to_srgb(c) * 255.0 + 0.5) as u8);
+            }
+            out.push((p.w.clamp(0.0, 1.0) * 255.0 + 0.5) as u8);
+        }
+        out
+    }
+
+    /// Writes by extension, atomically.
+    pub fn write(&self, path: &Path) -> Result<(), LoadError> {
+        match ImageFormat::of(path) {
+            Some(ImageFormat::Png) => {
+                let bytes = self.to_srgb8();
+                write_atomic(path, |w| {
+                    use image::ImageEncoder;
+                    image::codecs::png::PngEncoder::new(w)
+                        .write_image(
+                            &bytes,
+                            self.width,
+                            self.height,
+                            image::ExtendedColorType::Rgba8,
+                        )
+                        .map_err(std::io::Error::other)
+                })
+            }
+            Some(ImageFormat::Exr) => self.write_exr(path),
+            None => Err(LoadError::invalid(
+                path,
+                "unsupported image type: expected .png or .exr",
+            )),
+        }
+    }
+
+    fn write_exr(&self, path: &Path) -> Result<(), LoadError> {
+        use exr::prelude::*;
+        let (w, h) = (self.width as usize, self.height as usize);
+        let tmp = temporary_name(path);
+        let pixels = &self.pixels;
+        let image = Image::from_channels(
+            (w, h),
+            SpecificChannels::rgba(|Vec2(x, y)| {
+                let p: Vec4 = pixels[y * w + x];
+                (p.x, p.y, p.z, p.w)
+            }),
+        );
+        image.write().to_file(&tmp).map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            LoadError::invalid(path, format!("writing EXR: {e}"))
+        })?;
+        std::fs::rename(&tmp, path).map_err(|e| LoadError::io(path, e))
+    }
+}

@@ -1,0 +1,141 @@
+//! Render statistics for `--stats`: rays by type, per-ray work, time per phase.
+
+use serde::Serialize;
+
+use crate::accel::scene::QueryStats;
+
+/// The kinds of ray the integrator traces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RayKind {
+    Primary,
+    Shadow,
+    Reflection,
+    Refraction,
+}
+
+/// Minimum, mean and maximum of a per-ray quantity.
+#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
+pub struct Spread {
+    pub min: u64,
+    pub mean: f64,
+    pub max: u64,
+}
+
+/// Running sum of one per-ray quantity.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Tally {
+    min: u64,
+    max: u64,
+    sum: u64,
+}
+
+impl Default for Tally {
+    fn default() -> Self {
+        Tally {
+            min: u64::MAX,
+            max: 0,
+            sum: 0,
+        }
+    }
+}
+
+impl Tally {
+    fn push(&mut self, x: u64) {
+        self.min = self.min.min(x);
+        self.max = self.max.max(x);
+        self.sum += x;
+    }
+    fn merge(&mut self, o: &Tally) {
+        self.min = self.min.min(o.min);
+        self.max = self.max.max(o.max);
+        self.sum += o.sum;
+    }
+    fn spread(&self, n: u64) -> Spread {
+        Spread {
+            min: if n == 0 { 0 } else { self.min },
+            mean: if n == 0 {
+                0.0
+            } else {
+                self.sum as f64 / n as f64
+            },
+            max: self.max,
+        }
+    }
+}
+
+/// Per-thread accumulation of ray statistics; merged at the end.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RayTally {
+    counts: [u64; 4],
+    patch_tests: Tally,
+    splits: Tally,
+    box_tests: Tally,
+    nodes: Tally,
+}
+
+impl RayTally {
+    pub fn record(&mut self, kind: RayKind, q: &QueryStats) {
+        self.counts[kind as usize] += 1;
+        self.patch_tests.push(q.kernel.patch_tests);
+        self.splits.push(q.kernel.splits);
+        self.box_tests.push(q.kernel.box_tests + q.bvh_box_tests);
+        self.nodes.push(q.nodes_visited);
+    }
+
+    pub fn merge(mut self, o: RayTally) -> RayTally {
+        for (a, b) in self.counts.iter_mut().zip(o.counts) {
+            *a += b;
+        }
+        self.patch_tests.merge(&o.patch_tests);
+        self.splits.merge(&o.splits);
+        self.box_tests.merge(&o.box_tests);
+        self.nodes.merge(&o.nodes);
+        self
+    }
+
+    pub fn count(&self, kind: RayKind) -> u64 {
+        self.counts[kind as usize]
+    }
+
+    pub fn total(&self) -> u64 {
+        self.counts.iter().sum()
+    }
+
+    pub fn report(&self) -> RayReport {
+        let n = self.total();
+        RayReport {
+            primary: self.counts[RayKind::Primary as usize],
+            shadow: self.counts[RayKind::Shadow as usize],
+            reflection: self.counts[RayKind::Reflection as usize],
+            refraction: self.counts[RayKind::Refraction as usize],
+            total: n,
+            patch_tests_per_ray: self.patch_tests.spread(n),
+            splits_per_ray: self.splits.spread(n),
+            box_tests_per_ray: self.box_tests.spread(n),
+            bvh_nodes_per_ray: self.nodes.spread(n),
+        }
+    }
+}
+
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct RayReport {
+    pub primary: u64,
+    pub shadow: u64,
+    pub reflection: u64,
+    pub refraction: u64,
+    pub total: u64,
+    pub patch_tests_per_ray: Spread,
+    pub splits_per_ray: Spread,
+    pub box_tests_per_ray: Spread,
+    pub bvh_nodes_per_ray: Spread,
+}
+
+/// Wall-clock seconds per phase.
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+pub struct PhaseTimes {
+    pub load: f64,
+    /// Preparing patches for the kernel and building (or loading) the BVH.
+    pub prepare: f64,
+    pub render: f64,
+    pub write: f64,
+}
