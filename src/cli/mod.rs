@@ -8,6 +8,7 @@ mod bvh;
 mod convert;
 mod import;
 mod info;
+pub mod man;
 mod render;
 mod setup;
 pub mod trace;

@@ -1,0 +1,201 @@
+//! `render`, `bvh` and the effect plan, driven through the real binary on small images.
+
+mod common;
+
+use common::{run, stderr, stdout, testdata};
+
+fn stats(scene: &str, extra: &[&str]) -> serde_json::Value {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.png");
+    let scene = testdata(scene);
+    let mut args = vec![
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--stats",
+        "-q",
+    ];
+    args.extend_from_slice(&["--width", "24", "--height", "24"]);
+    args.extend_from_slice(extra);
+    let o = run(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    serde_json::from_str(&stdout(&o)).expect("stats JSON")
+}
+
+#[test]
+fn ray_counts_by_type_follow_the_effect_plan() {
+    // Reflective teapot, one light: shadows and reflection, no refraction.
+    let s = stats("teapot.ron", &[]);
+    assert_eq!(s["rays"]["primary"], 24 * 24);
+    assert!(s["rays"]["shadow"].as_u64().unwrap() > 0);
+    assert!(s["rays"]["reflection"].as_u64().unwrap() > 0);
+    assert_eq!(s["rays"]["refraction"], 0);
+    assert_eq!(s["plan"]["refraction"], false);
+
+    // Glass: refraction rays appear.
+    let s = stats("glass_teapot.ron", &[]);
+    assert!(s["rays"]["refraction"].as_u64().unwrap() > 0);
+    assert_eq!(s["plan"]["refraction"], true);
+
+    // Diffuse: primary and shadow rays only, depth 1.
+    let s = stats("diffuse.ron", &[]);
+    assert_eq!(s["plan"]["max_depth"], 1);
+    assert_eq!(s["rays"]["reflection"], 0);
+    assert_eq!(s["rays"]["refraction"], 0);
+    assert!(s["rays"]["shadow"].as_u64().unwrap() > 0);
+    assert_eq!(
+        s["rays"]["total"].as_u64().unwrap(),
+        s["rays"]["primary"].as_u64().unwrap() + s["rays"]["shadow"].as_u64().unwrap()
+    );
+}
+
+#[test]
+fn a_scene_without_lights_traces_no_shadow_rays() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("dark.ron");
+    let src = std::fs::read_to_string(testdata("diffuse.ron")).unwrap();
+    let start = src.find("lights: [").unwrap();
+    let end = start + src[start..].find("],").unwrap() + 2;
+    let src = format!("{}{}", &src[..start], &src[end..]).replace(
+        "File(\"teapot.bpt\")",
+        &format!("File({:?})", testdata("teapot.bpt")),
+    );
+    std::fs::write(&scene, src).unwrap();
+    let out = dir.path().join("x.png");
+    let o = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--stats",
+        "-q",
+        "--width",
+        "16",
+        "--height",
+        "16",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(s["plan"]["shadows"], false);
+    assert_eq!(s["rays"]["shadow"], 0);
+    assert!(stderr(&o).contains("no shadows"), "{}", stderr(&o));
+}
+
+#[test]
+fn image_bytes_do_not_depend_on_the_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = testdata("teapot.ron");
+    let mut images = Vec::new();
+    for threads in ["1", "2", "3"] {
+        let out = dir.path().join(format!("t{threads}.png"));
+        let o = run(&[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+            "--width",
+            "40",
+            "--height",
+            "30",
+            "--threads",
+            threads,
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        images.push(std::fs::read(&out).unwrap());
+    }
+    assert_eq!(images[0], images[1]);
+    assert_eq!(images[0], images[2]);
+}
+
+#[test]
+fn a_saved_bvh_renders_the_same_bytes_and_a_stale_one_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = testdata("teapot.ron");
+    let bvh = dir.path().join("teapot.bvh");
+    let o = run(&["bvh", scene.to_str().unwrap(), "-o", bvh.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let render = |extra: &[&str], name: &str| {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+            "--width",
+            "32",
+            "--height",
+            "32",
+        ];
+        args.extend_from_slice(extra);
+        let o = run(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        std::fs::read(out).unwrap()
+    };
+    assert_eq!(
+        render(&[], "built.png"),
+        render(&["--bvh", bvh.to_str().unwrap()], "loaded.png")
+    );
+
+    // The diffuse scene rotates the teapot: different geometry, so the file is stale.
+    let other = testdata("diffuse.ron");
+    let out = dir.path().join("stale.png");
+    let o = run(&[
+        "render",
+        other.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+        "--bvh",
+        bvh.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("rebuild"), "{}", stderr(&o));
+    assert!(!out.exists());
+
+    // Not a BVH file at all.
+    let o = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+        "--bvh",
+        scene.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
+#[test]
+fn exr_output_is_linear_rgba_with_coverage_alpha() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.exr");
+    let scene = testdata("teapot.ron");
+    let o = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+        "--width",
+        "20",
+        "--height",
+        "20",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    use exr::prelude::*;
+    let img = read_first_rgba_layer_from_file(
+        &out,
+        |res, _| vec![vec![(0f32, 0f32, 0f32, 0f32); res.width()]; res.height()],
+        |px: &mut Vec<Vec<(f32, f32, f32, f32)>>, pos, (r, g, b, a): (f32, f32, f32, f32)| {
+            px[pos.y()][pos.x()] = (r, g, b, a)
+        },
+    )
+    .unwrap();
+    let px = &img.layer_data.channel_data.pixels;
+    // Top row looks over the floor's far edge into the background; the centre sees the teapot.
+    assert_eq!(px[0][10].3, 0.0);
+    assert_eq!(px[12][10].3, 1.0);
+}
