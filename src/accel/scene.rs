@@ -6,7 +6,7 @@
 use glam::DVec3;
 
 use super::bvh::{Bvh, GeometryHasher};
-use crate::geom::{Aabb, BezierPatch, Ray};
+use crate::geom::{Aabb, BezierPatch, DAabb, Ray};
 use crate::kernel::subdivision::{self, PreparedPatch, SubdivisionConfig};
 use crate::kernel::{KernelStats, PatchHit};
 use crate::scene::Scene;
@@ -167,10 +167,12 @@ impl SceneGeometry {
         for (prim, patch) in self.originals.iter().enumerate() {
             let b = self.prepared[prim].bounds();
             stats.bvh_box_tests += 1;
-            let (lo, hi) = (b.min.as_dvec3(), b.max.as_dvec3());
-            let (t0, t1) = ((lo - origin) * inv, (hi - origin) * inv);
+            let b = DAabb {
+                min: b.min.as_dvec3(),
+                max: b.max.as_dvec3(),
+            };
             let limit = best.as_ref().map_or(tmax, |(_, h)| h.t);
-            if t0.min(t1).max_element().max(tmin) > t1.max(t0).min_element().min(limit) {
+            if b.intersect(origin, inv, tmin, limit).is_none() {
                 continue;
             }
             stats.kernel.patch_tests += 1;

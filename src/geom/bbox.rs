@@ -77,7 +77,7 @@ impl Aabb {
 
     /// Robust slab test: the parametric interval where `origin + t d` is inside the box,
     /// clipped to `[tmin, tmax]`, or `None`. `inv_dir` is `1 / d` per component (infinite
-    /// for a zero component, which the IEEE rules handle, except `0 * inf`, see below).
+    /// for a zero component).
     #[inline(always)]
     pub fn intersect(
         &self,
@@ -89,10 +89,12 @@ impl Aabb {
         let t0 = (self.min - origin) * inv_dir;
         let t1 = (self.max - origin) * inv_dir;
         // A zero direction component with the origin exactly on a slab plane gives
-        // 0 * inf = NaN; `min`/`max` of glam pick the non-NaN operand, so the slab is then
-        // treated as unbounded in that axis, which is the correct limit.
-        let near = t0.min(t1);
-        let far = t0.max(t1) * SLAB_FAR_SCALE;
+        // 0 * inf = NaN. The ray then lies in the plane, so that slab bounds nothing: NaN
+        // must become -inf for the entry and +inf for the exit. (`min`/`max` alone would
+        // pick the other, infinite operand and wrongly miss the box.)
+        let nan = t0.is_nan_mask() | t1.is_nan_mask();
+        let near = Vec3::select(nan, Vec3::NEG_INFINITY, t0.min(t1));
+        let far = Vec3::select(nan, Vec3::INFINITY, t0.max(t1) * SLAB_FAR_SCALE);
         let t_enter = near.max_element().max(tmin);
         let t_exit = far.min_element().min(tmax);
         (t_enter <= t_exit).then_some((t_enter, t_exit))
@@ -134,6 +136,26 @@ impl DAabb {
 
     pub fn center(&self) -> DVec3 {
         (self.min + self.max) * 0.5
+    }
+
+    /// The slab test in `f64`, with the same treatment of rays lying in a slab plane as
+    /// [`Aabb::intersect`]. Exact enough without a far-scale: the reference path tests
+    /// every candidate this way.
+    pub fn intersect(
+        &self,
+        origin: DVec3,
+        inv_dir: DVec3,
+        tmin: f64,
+        tmax: f64,
+    ) -> Option<(f64, f64)> {
+        let t0 = (self.min - origin) * inv_dir;
+        let t1 = (self.max - origin) * inv_dir;
+        let nan = t0.is_nan_mask() | t1.is_nan_mask();
+        let near = DVec3::select(nan, DVec3::NEG_INFINITY, t0.min(t1));
+        let far = DVec3::select(nan, DVec3::INFINITY, t0.max(t1));
+        let t_enter = near.max_element().max(tmin);
+        let t_exit = far.min_element().min(tmax);
+        (t_enter <= t_exit).then_some((t_enter, t_exit))
     }
 
     /// Length of the diagonal (0 for a point, NaN never: empty boxes give 0).
@@ -206,6 +228,25 @@ mod tests {
         let o = Vec3::new(1.0, 0.0, -5.0);
         let d = Vec3::new(0.0, 0.0, 1.0);
         assert!(b.intersect(o, d.recip(), 0.0, f32::INFINITY).is_some());
+    }
+
+    #[test]
+    fn ray_in_a_face_plane_with_zero_direction_component_hits() {
+        // Regression: origin.x == min.x and d.x == 0 gives 0 * inf = NaN in the x slab,
+        // which min/max resolved to +inf, missing the box (a crack on shared edges).
+        let b = Aabb::new(Vec3::new(0.0, -1.0, -1.0), Vec3::new(1.4, 1.0, 1.0));
+        let o = Vec3::new(0.0, -8.0, 0.0);
+        let d = Vec3::new(0.0, 1.0, 0.0);
+        let (t0, _) = b.intersect(o, d.recip(), 0.0, f32::INFINITY).expect("hit");
+        assert_eq!(t0, 7.0);
+        let db = DAabb {
+            min: b.min.as_dvec3(),
+            max: b.max.as_dvec3(),
+        };
+        let (t0, _) = db
+            .intersect(o.as_dvec3(), d.as_dvec3().recip(), 0.0, f64::INFINITY)
+            .expect("hit");
+        assert_eq!(t0, 7.0);
     }
 
     #[test]
