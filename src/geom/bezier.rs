@@ -430,3 +430,7 @@ pub(crate) fn split_curve_half(points: &[DVec4], left: &mut [DVec4], right: &mut
         }
     }
 }
+
+#[cfg(test)]
+#[path = "bezier_tests.rs"]
+mod tests;
