@@ -247,3 +247,19 @@ fn ron_round_trips_through_import() {
         assert_eq!(a.materials[x.material], b.materials[y.material]);
     }
 }
+
+#[test]
+fn a_closed_pipe_is_not_an_error() {
+    // `patchtrace info x | head -1`: stdout closes early; no panic, status 0.
+    use std::process::Stdio;
+    let mut child = common::bin()
+        .args(["info", testdata("teapot.ron").to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}

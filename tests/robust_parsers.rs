@@ -29,14 +29,29 @@ enum Mutation {
     Truncate(usize),
 }
 
-const REPLACEMENTS: &[&str] = &["nan", "NaN", "inf", "-inf", "1e39", "-1e308", "", "0", "-0", "1e-45", "99999999999999999999", "-1", "x"];
+const REPLACEMENTS: &[&str] = &[
+    "nan",
+    "NaN",
+    "inf",
+    "-inf",
+    "1e39",
+    "-1e308",
+    "",
+    "0",
+    "-0",
+    "1e-45",
+    "99999999999999999999",
+    "-1",
+    "x",
+];
 
 fn mutation() -> impl Strategy<Value = Mutation> {
     prop_oneof![
         (any::<usize>(), 1u8..=255).prop_map(|(at, bits)| Mutation::FlipByte { at, bits }),
         any::<usize>().prop_map(Mutation::DropLine),
         any::<usize>().prop_map(Mutation::RepeatLine),
-        (any::<usize>(), prop::sample::select(REPLACEMENTS)).prop_map(|(which, with)| Mutation::ReplaceNumber { which, with }),
+        (any::<usize>(), prop::sample::select(REPLACEMENTS))
+            .prop_map(|(which, with)| Mutation::ReplaceNumber { which, with }),
         any::<usize>().prop_map(Mutation::Truncate),
     ]
 }
@@ -122,7 +137,11 @@ fn located(e: &ParseError) -> bool {
 fn fuzz<T>(ext: &str, parse: impl Fn(&Path, &str) -> Result<T, ParseError>) {
     let files = samples(ext);
     assert!(!files.is_empty(), "no .{ext} samples in testdata/");
-    let mut runner = TestRunner::new(Config { cases: cases(), failure_persistence: None, ..Config::default() });
+    let mut runner = TestRunner::new(Config {
+        cases: cases(),
+        failure_persistence: None,
+        ..Config::default()
+    });
     let strategy = (0..files.len(), prop::collection::vec(mutation(), 1..4));
     runner
         .run(&strategy, |(f, muts)| {
@@ -143,7 +162,13 @@ fn bpt_parser_survives_mutations() {
 
 #[test]
 fn obj_parser_survives_mutations() {
-    fuzz("obj", |p, s| if obj::is_freeform(s) { obj::parse_obj_freeform(p, s).map(|_| ()) } else { Ok(()) });
+    fuzz("obj", |p, s| {
+        if obj::is_freeform(s) {
+            obj::parse_obj_freeform(p, s).map(|_| ())
+        } else {
+            Ok(())
+        }
+    });
 }
 
 #[test]
@@ -164,7 +189,13 @@ fn ray_file_parser_survives_mutations() {
 #[test]
 fn mutations_do_change_the_text() {
     // The harness itself: a number replacement really replaces a number.
-    let t = apply("1 2.5 3", &[Mutation::ReplaceNumber { which: 1, with: "nan" }]);
+    let t = apply(
+        "1 2.5 3",
+        &[Mutation::ReplaceNumber {
+            which: 1,
+            with: "nan",
+        }],
+    );
     assert_eq!(t, "1 nan 3");
     assert_eq!(apply("a\nb\nc", &[Mutation::DropLine(1)]), "a\nc");
     assert_eq!(apply("a\nb", &[Mutation::RepeatLine(0)]), "a\na\nb");

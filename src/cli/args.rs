@@ -27,6 +27,40 @@ pub enum Command {
     Render(RenderArgs),
     /// Nearest hit per ray from a ray file, as CSV.
     Trace(TraceArgs),
+    /// Generate test scenes.
+    #[command(subcommand)]
+    Scene(SceneCommand),
+}
+
+#[derive(Debug, Subcommand)]
+pub enum SceneCommand {
+    /// Randomly scattered Utah teapots (LG90 §7): writes OUT.ron and teapot.bpt beside it.
+    Teapots(TeapotsArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct TeapotsArgs {
+    /// Number of teapots (32 bicubic patches each).
+    #[arg(long, default_value_t = 50)]
+    pub count: usize,
+    /// Random seed: the same seed gives the same scene.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Give the teapots a reflective material (reflect 0.3).
+    #[arg(long)]
+    pub reflective: bool,
+    /// Number of point lights.
+    #[arg(long, default_value_t = 1)]
+    pub lights: usize,
+    /// Image width.
+    #[arg(long, default_value_t = 512)]
+    pub width: u32,
+    /// Image height.
+    #[arg(long, default_value_t = 512)]
+    pub height: u32,
+    /// Output scene (.ron).
+    #[arg(short, long)]
+    pub output: PathBuf,
 }
 
 #[derive(Debug, Args)]

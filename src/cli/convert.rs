@@ -1,5 +1,6 @@
 //! `patchtrace convert IN -o OUT`: NURBS → Bézier by knot insertion, with a report.
 
+use std::io::Write;
 use std::process::ExitCode;
 
 use crate::cli::args::ConvertArgs;
@@ -10,31 +11,48 @@ pub fn run(args: ConvertArgs) -> anyhow::Result<ExitCode> {
     let scene = load_scene(&args.input)?;
     let (converted, report) = convert_scene(&scene);
     write_scene_as(&args.output, &converted)?;
+    let mut out = std::io::stdout().lock();
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        writeln!(out, "{}", serde_json::to_string_pretty(&report)?)?;
     } else {
         let kb = |b: usize| b as f64 / 1024.0;
-        println!("NURBS surfaces:          {}", report.nurbs_surfaces);
-        println!("  control points:        {}", report.nurbs_control_points);
-        println!("  size:                  {:.2} kB", kb(report.nurbs_bytes));
-        println!(
+        writeln!(out, "NURBS surfaces:          {}", report.nurbs_surfaces)?;
+        writeln!(
+            out,
+            "  control points:        {}",
+            report.nurbs_control_points
+        )?;
+        writeln!(
+            out,
+            "  size:                  {:.2} kB",
+            kb(report.nurbs_bytes)
+        )?;
+        writeln!(
+            out,
             "Bézier patches (made):   {}",
             report.bezier_patches_from_nurbs
-        );
-        println!(
+        )?;
+        writeln!(
+            out,
             "  control points:        {}",
             report.bezier_control_points_from_nurbs
-        );
-        println!("  size:                  {:.2} kB", kb(report.bezier_bytes));
-        println!(
+        )?;
+        writeln!(
+            out,
+            "  size:                  {:.2} kB",
+            kb(report.bezier_bytes)
+        )?;
+        writeln!(
+            out,
             "Bézier patches (as is):  {}",
             report.bezier_patches_unchanged
-        );
-        println!(
+        )?;
+        writeln!(
+            out,
             "memory ratio:            {:.3} (Dammertz Table 2.13)",
             report.memory_ratio
-        );
-        println!("wrote {}", args.output.display());
+        )?;
+        writeln!(out, "wrote {}", args.output.display())?;
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -1,5 +1,6 @@
 //! `patchtrace info SCENE`: describe a scene.
 
+use std::io::Write;
 use std::process::ExitCode;
 
 use crate::cli::args::InfoArgs;
@@ -9,49 +10,55 @@ use crate::scene::summary::summarize;
 pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
     let scene = load_scene(&args.scene)?;
     let s = summarize(&scene);
+    let mut out = std::io::stdout().lock();
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&s)?);
+        writeln!(out, "{}", serde_json::to_string_pretty(&s)?)?;
         return Ok(ExitCode::SUCCESS);
     }
-    println!("scene: {}", args.scene.display());
+    writeln!(out, "scene: {}", args.scene.display())?;
     let c = &s.camera;
-    println!(
+    writeln!(
+        out,
         "camera: eye {:?} look_at {:?} up {:?} fov_y {} deg, {}x{}",
         c.eye, c.look_at, c.up, c.fov_y, c.width, c.height
-    );
-    println!(
+    )?;
+    writeln!(
+        out,
         "objects: {}  patches: {} ({} rational)  NURBS surfaces: {}  triangles: {}",
         s.objects.len(),
         s.patches,
         s.rational_patches,
         s.nurbs_surfaces,
         s.triangles
-    );
+    )?;
     for o in &s.objects {
-        println!(
+        writeln!(
+            out,
             "  {}: material \"{}\", {} surface(s), {} NURBS, {} patch(es), {} trim loop(s), {} triangle(s)",
             o.name, o.material, o.surfaces, o.nurbs_surfaces, o.patches, o.trim_loops, o.triangles
-        );
+        )?;
     }
     let degrees: Vec<String> = s.degrees.iter().map(|(d, n)| format!("{d}: {n}")).collect();
-    println!(
+    writeln!(
+        out,
         "degrees: {}",
         if degrees.is_empty() {
             "-".into()
         } else {
             degrees.join(", ")
         }
-    );
-    println!("bounds: {:?} .. {:?}", s.bounds_min, s.bounds_max);
-    println!("materials: {}", s.materials.join(", "));
-    println!(
+    )?;
+    writeln!(out, "bounds: {:?} .. {:?}", s.bounds_min, s.bounds_max)?;
+    writeln!(out, "materials: {}", s.materials.join(", "))?;
+    writeln!(
+        out,
         "lights: {}",
         if s.lights.is_empty() {
             "none".into()
         } else {
             s.lights.join("; ")
         }
-    );
-    println!("max depth: {}", s.max_depth);
+    )?;
+    writeln!(out, "max depth: {}", s.max_depth)?;
     Ok(ExitCode::SUCCESS)
 }

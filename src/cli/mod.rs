@@ -10,6 +10,7 @@ mod import;
 mod info;
 pub mod man;
 mod render;
+mod scene_gen;
 mod setup;
 pub mod trace;
 
@@ -53,6 +54,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Bvh(a) => bvh::run(a),
         Command::Render(a) => render::run(a),
         Command::Trace(a) => trace::run(a),
+        Command::Scene(args::SceneCommand::Teapots(a)) => scene_gen::teapots(a),
     }
 }
 

@@ -1,5 +1,6 @@
 //! `patchtrace render SCENE -o OUT.png|OUT.exr`.
 
+use std::io::Write;
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -65,6 +66,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     film.write(&args.output)?;
     let write_seconds = start.elapsed().as_secs_f64();
     if args.stats {
+        let mut out = std::io::stdout().lock();
         let stats = RenderStats {
             plan,
             width: film.width,
@@ -79,7 +81,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
                 write: write_seconds,
             },
         };
-        println!("{}", serde_json::to_string_pretty(&stats)?);
+        writeln!(out, "{}", serde_json::to_string_pretty(&stats)?)?;
     }
     if !args.quiet {
         eprintln!(

@@ -6,6 +6,7 @@
 pub mod bpt;
 pub mod convert;
 pub mod error;
+pub mod generate;
 pub mod load;
 pub mod mesh;
 pub mod model;
