@@ -11,3 +11,4 @@ pub mod geom;
 pub mod kernel;
 pub mod render;
 pub mod scene;
+pub mod tessellate;
