@@ -93,9 +93,12 @@ impl EdgeCurve {
     }
 
     /// The curve point at canonical parameter `k / n`. The end points are the end control
-    /// points themselves, so corners shared by several patches are bit-identical.
+    /// points themselves, so corners shared by several patches are bit-identical; a curve
+    /// collapsed to one point (the teapot's lid knob and bottom centre) is that point, since
+    /// de Casteljau's `(1 - t) a + t a` need not round back to `a`.
     pub fn sample(&self, k: usize, n: usize) -> DVec3 {
-        let p = if k == 0 {
+        let collapsed = self.points.iter().all(|&p| p == self.points[0]);
+        let p = if k == 0 || collapsed {
             self.points[0]
         } else if k == n {
             self.points[self.points.len() - 1]
