@@ -5,6 +5,7 @@
 //!   stops shrinking in `f32`, with an `f64` twin that is the accuracy reference.
 
 pub mod subdivision;
+pub mod triangle;
 
 use crate::geom::Aabb;
 
