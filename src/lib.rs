@@ -15,3 +15,4 @@ pub mod geom;
 pub mod kernel;
 pub mod render;
 pub mod scene;
+pub mod tessellate;

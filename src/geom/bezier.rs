@@ -379,7 +379,7 @@ pub(crate) fn dehomogenize(p: DVec4) -> DVec3 {
 }
 
 /// De Casteljau evaluation of a homogeneous curve at t.
-fn de_casteljau_point(points: &[DVec4], t: f64) -> DVec4 {
+pub(crate) fn de_casteljau_point(points: &[DVec4], t: f64) -> DVec4 {
     let mut work: Vec<DVec4> = points.to_vec();
     let n = work.len();
     for k in 1..n {

@@ -6,6 +6,7 @@
 
 pub mod secondary;
 pub mod subdivision;
+pub mod triangle;
 
 use crate::geom::Aabb;
 

@@ -1,0 +1,337 @@
+//! Triangle tessellation of Bézier patches: the baseline that the direct ray tracer is
+//! compared against (Dammertz 2005, §3.4 and Tables 2.1–2.4, which tessellate every patch
+//! into 512, 4608 and 131072 triangles).
+//!
+//! Every vertex is a point of the exact surface evaluated in `f64` (de Casteljau), with
+//! the normal from the exact derivatives ([`BezierPatch::normal`], which also handles the
+//! collapsed edges of the teapot's lid and bottom). The mesh is crack-free across patch
+//! borders: boundary curves are shared objects ([`edge`]), sampled once from a canonical
+//! direction, and vertices are welded by their exact `f64` position. Where a patch's grid
+//! is finer than one of its boundary curves (adaptive mode), the ring of triangles next to
+//! that boundary is stitched by merging the two vertex loops by parameter ([`stitch`]).
+
+mod edge;
+mod stitch;
+pub mod write;
+
+use std::collections::HashMap;
+
+use glam::DVec3;
+use thiserror::Error;
+
+use crate::geom::BezierPatch;
+use crate::scene::model::{Geometry, Object, Scene, TriangleMesh};
+
+pub use edge::MAX_ADAPTIVE_SEGMENTS;
+use edge::{EdgeCurve, EdgeKey, Side, segments_for_tolerance};
+pub use write::{MeshFormat, write_mesh_scene};
+
+/// How finely each patch is cut.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TessellationMode {
+    /// A `grid_u` × `grid_v` grid of quads per patch, each split into two triangles.
+    Uniform { grid_u: u32, grid_v: u32 },
+    /// `n` triangles per patch: the grid `g_u × g_v` with `2 g_u g_v = n` that is closest
+    /// to square (`g_u ≥ g_v`, `g_v` the largest divisor of n/2 not above √(n/2)), so
+    /// n = 2k² gives the k × k grid of Dammertz's tables (512 → 16², 4608 → 48²,
+    /// 131072 → 256²). Odd n has no such grid and is rejected.
+    TrianglesPerPatch(u32),
+    /// Chord height at most `tolerance` (scene units) along every boundary curve and along
+    /// the mid-parameter curves of each patch.
+    Adaptive { tolerance: f64 },
+}
+
+/// Why a scene could not be tessellated.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum TessellateError {
+    #[error(
+        "{0} triangles per patch is not 2·g_u·g_v for whole grid sizes g_u, g_v ≥ 1; use an even count such as 512 (16×16), 4608 (48×48) or 131072 (256×256)"
+    )]
+    TriangleCount(u32),
+    #[error("grid {0}×{1}: both grid sizes must be at least 1")]
+    Grid(u32, u32),
+    #[error("tolerance {0} must be a positive finite number")]
+    Tolerance(f64),
+    #[error("the mesh would have more than 2^32 - 1 vertices")]
+    TooManyVertices,
+    #[error("object {0:?} has trimmed surfaces, which the tessellator does not support yet")]
+    Trimmed(String),
+}
+
+/// Size of a tessellation. `bytes` is the memory the triangle path renders from: `f32`
+/// positions and normals (24 bytes per vertex) and `u32` indices (12 bytes per triangle).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct TessellationReport {
+    pub triangles: u64,
+    pub vertices: u64,
+    pub bytes: u64,
+}
+
+/// Bytes per vertex of the rendered mesh: three `f32` position and three `f32` normal
+/// coordinates.
+const BYTES_PER_VERTEX: u64 = 24;
+/// Bytes per triangle: three `u32` indices.
+const BYTES_PER_TRIANGLE: u64 = 12;
+
+impl TessellationReport {
+    pub fn of(mesh: &TriangleMesh) -> Self {
+        let (triangles, vertices) = (mesh.indices.len() as u64, mesh.positions.len() as u64);
+        TessellationReport {
+            triangles,
+            vertices,
+            bytes: vertices * BYTES_PER_VERTEX + triangles * BYTES_PER_TRIANGLE,
+        }
+    }
+
+    pub fn add(&mut self, other: &TessellationReport) {
+        self.triangles += other.triangles;
+        self.vertices += other.vertices;
+        self.bytes += other.bytes;
+    }
+}
+
+/// Where a vertex came from: the patch (index into the slice given to
+/// [`tessellate_patches`]) and the parameters in that patch's own [0,1]². A vertex shared
+/// by several patches records the first one that made it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VertexParam {
+    pub patch: u32,
+    pub u: f64,
+    pub v: f64,
+}
+
+/// A tessellated set of patches with the parameters of each vertex.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PatchMesh {
+    pub mesh: TriangleMesh,
+    pub params: Vec<VertexParam>,
+}
+
+/// Replaces every surface object of `scene` by its tessellation; meshes are kept as they
+/// are. Camera, lights and materials are unchanged, so the result renders comparably.
+pub fn tessellate_scene(
+    scene: &Scene,
+    mode: TessellationMode,
+) -> Result<(Scene, TessellationReport), TessellateError> {
+    let mut report = TessellationReport::default();
+    let mut objects = Vec::with_capacity(scene.objects.len());
+    for object in &scene.objects {
+        let (o, r) = tessellate_object(object, mode)?;
+        report.add(&r);
+        objects.push(o);
+    }
+    Ok((
+        Scene {
+            objects,
+            ..scene.clone()
+        },
+        report,
+    ))
+}
+
+/// One object's tessellation (a mesh object is returned unchanged).
+pub fn tessellate_object(
+    object: &Object,
+    mode: TessellationMode,
+) -> Result<(Object, TessellationReport), TessellateError> {
+    let mesh = match &object.geometry {
+        Geometry::Mesh(m) => m.clone(),
+        Geometry::Surfaces(surfaces) => {
+            if surfaces.iter().any(|s| !s.trims.is_empty()) {
+                return Err(TessellateError::Trimmed(object.name.clone()));
+            }
+            tessellate_patches(&object.bezier_patches(), mode)?.mesh
+        }
+    };
+    let report = TessellationReport::of(&mesh);
+    Ok((
+        Object {
+            geometry: Geometry::Mesh(mesh),
+            ..object.clone()
+        },
+        report,
+    ))
+}
+
+/// Tessellates patches into one welded, crack-free mesh, keeping each vertex's (u, v).
+pub fn tessellate_patches(
+    patches: &[BezierPatch],
+    mode: TessellationMode,
+) -> Result<PatchMesh, TessellateError> {
+    let plan = Plan::new(mode)?;
+    let mut t = Tessellator::default();
+    for (index, patch) in patches.iter().enumerate() {
+        t.patch(index as u32, patch, plan)?;
+    }
+    Ok(t.out)
+}
+
+/// A validated mode.
+#[derive(Clone, Copy)]
+enum Plan {
+    Uniform { grid_u: usize, grid_v: usize },
+    Adaptive { tolerance: f64 },
+}
+
+impl Plan {
+    fn new(mode: TessellationMode) -> Result<Plan, TessellateError> {
+        match mode {
+            TessellationMode::Uniform { grid_u, grid_v } => {
+                if grid_u == 0 || grid_v == 0 {
+                    return Err(TessellateError::Grid(grid_u, grid_v));
+                }
+                Ok(Plan::Uniform {
+                    grid_u: grid_u as usize,
+                    grid_v: grid_v as usize,
+                })
+            }
+            TessellationMode::TrianglesPerPatch(n) => {
+                let (grid_u, grid_v) = grid_for_triangles(n)?;
+                Ok(Plan::Uniform {
+                    grid_u: grid_u as usize,
+                    grid_v: grid_v as usize,
+                })
+            }
+            TessellationMode::Adaptive { tolerance } => {
+                if !(tolerance.is_finite() && tolerance > 0.0) {
+                    return Err(TessellateError::Tolerance(tolerance));
+                }
+                Ok(Plan::Adaptive { tolerance })
+            }
+        }
+    }
+}
+
+/// The grid `(g_u, g_v)` for `n` triangles per patch; see
+/// [`TessellationMode::TrianglesPerPatch`].
+pub fn grid_for_triangles(n: u32) -> Result<(u32, u32), TessellateError> {
+    if n == 0 || n % 2 != 0 {
+        return Err(TessellateError::TriangleCount(n));
+    }
+    let cells = n / 2;
+    let grid_v = (1..=cells)
+        .take_while(|g| g * g <= cells)
+        .filter(|g| cells % g == 0)
+        .last()
+        .unwrap_or(1);
+    Ok((cells / grid_v, grid_v))
+}
+
+#[derive(Default)]
+struct Tessellator {
+    out: PatchMesh,
+    /// Exact position bits → vertex index.
+    weld: HashMap<[u64; 3], u32>,
+    /// Shared boundary curves → their vertices in canonical order, both ends included.
+    edges: HashMap<EdgeKey, Vec<u32>>,
+}
+
+impl Tessellator {
+    fn patch(
+        &mut self,
+        index: u32,
+        patch: &BezierPatch,
+        plan: Plan,
+    ) -> Result<(), TessellateError> {
+        let curves = Side::ALL.map(|s| EdgeCurve::of(patch, s));
+        let (mut grid_u, mut grid_v, wanted) = match plan {
+            Plan::Uniform { grid_u, grid_v } => (grid_u, grid_v, [grid_u, grid_v, grid_u, grid_v]),
+            Plan::Adaptive { tolerance } => {
+                let wanted = curves.each_ref().map(|c| c.adaptive_segments(tolerance));
+                let mid_u =
+                    segments_for_tolerance(&|t| patch.eval(t, 0.5), patch.degree_u(), tolerance);
+                let mid_v =
+                    segments_for_tolerance(&|t| patch.eval(0.5, t), patch.degree_v(), tolerance);
+                (
+                    wanted[0].max(wanted[2]).max(mid_u),
+                    wanted[1].max(wanted[3]).max(mid_v),
+                    wanted,
+                )
+            }
+        };
+        let mut sides: [Vec<u32>; 4] = Default::default();
+        for (k, side) in Side::ALL.into_iter().enumerate() {
+            sides[k] = self.side_vertices(index, patch, side, &curves[k], wanted[k])?;
+        }
+        if !stitch::sides_match(grid_u, grid_v, &sides) {
+            // The ring stitch needs at least one interior grid point.
+            grid_u = grid_u.max(2);
+            grid_v = grid_v.max(2);
+        }
+        let mut interior = vec![0u32; (grid_u + 1) * (grid_v + 1)];
+        for j in 1..grid_v {
+            for i in 1..grid_u {
+                let (u, v) = (i as f64 / grid_u as f64, j as f64 / grid_v as f64);
+                interior[j * (grid_u + 1) + i] =
+                    self.vertex(patch.eval(u, v), index, patch, u, v)?;
+            }
+        }
+        let grid = stitch::Grid {
+            nu: grid_u,
+            nv: grid_v,
+            interior: &interior,
+            sides: &sides,
+        };
+        let indices = &mut self.out.mesh.indices;
+        grid.triangulate(&mut |tri| {
+            if tri[0] != tri[1] && tri[1] != tri[2] && tri[2] != tri[0] {
+                indices.push(tri);
+            }
+        });
+        Ok(())
+    }
+
+    /// The side's vertices in counter-clockwise order, both corners included, made on
+    /// first use of the curve with `segments` segments and reused by every later patch.
+    fn side_vertices(
+        &mut self,
+        index: u32,
+        patch: &BezierPatch,
+        side: Side,
+        curve: &EdgeCurve,
+        segments: usize,
+    ) -> Result<Vec<u32>, TessellateError> {
+        let mut verts = match self.edges.get(&curve.key) {
+            Some(v) => v.clone(),
+            None => {
+                let mut v = Vec::with_capacity(segments + 1);
+                for k in 0..=segments {
+                    let t = k as f64 / segments as f64;
+                    let (u, w) = side.param(if curve.reversed { 1.0 - t } else { t });
+                    v.push(self.vertex(curve.sample(k, segments), index, patch, u, w)?);
+                }
+                self.edges.insert(curve.key.clone(), v.clone());
+                v
+            }
+        };
+        if curve.reversed {
+            verts.reverse();
+        }
+        Ok(verts)
+    }
+
+    /// The welded vertex at `p`, made (with the exact normal at (u, v)) if new.
+    fn vertex(
+        &mut self,
+        p: DVec3,
+        index: u32,
+        patch: &BezierPatch,
+        u: f64,
+        v: f64,
+    ) -> Result<u32, TessellateError> {
+        let p = p + DVec3::ZERO; // fold -0.0 into +0.0 so the key is unique
+        let key = p.to_array().map(f64::to_bits);
+        if let Some(&i) = self.weld.get(&key) {
+            return Ok(i);
+        }
+        let i = u32::try_from(self.out.mesh.positions.len())
+            .ok()
+            .filter(|&i| i != u32::MAX)
+            .ok_or(TessellateError::TooManyVertices)?;
+        self.out.mesh.positions.push(p);
+        self.out.mesh.normals.push(patch.normal(u, v));
+        self.out.params.push(VertexParam { patch: index, u, v });
+        self.weld.insert(key, i);
+        Ok(i)
+    }
+}
