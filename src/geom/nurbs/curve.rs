@@ -9,6 +9,9 @@ use super::basis::span_basis;
 use crate::geom::bezier::dehomogenize;
 
 /// A NURBS curve of degree `degree` with `points.len() + degree + 1` knots.
+/// Its methods expect what [`knots::validate`](super::knots::validate) checks and
+/// positive weights; curves taken from a valid [`NurbsSurface`](super::NurbsSurface)
+/// satisfy both.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NurbsCurve {
     pub degree: usize,
