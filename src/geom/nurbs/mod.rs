@@ -1,59 +1,28 @@
-//! NURBS surfaces: knot vectors, Cox–de Boor evaluation, Boehm knot insertion and exact
-//! decomposition into Bézier patches (Piegl & Tiller, *The NURBS Book*, A2.2, A5.1, A5.7;
-//! Dammertz 2005, §2.8).
+//! NURBS surfaces: knot vectors, Cox–de Boor evaluation, Boehm knot insertion, clamping and
+//! exact decomposition into Bézier patches (Piegl & Tiller, *The NURBS Book*, A2.1, A2.2,
+//! A5.1, A5.6/A5.7), the conversion Dammertz 2005, §2.8 uses to ray trace NURBS as Bézier
+//! patches.
+//!
+//! - `knots`: validation, multiplicity, domain.
+//! - `basis`: FindSpan and BasisFuns.
+//! - `curve`: the NURBS curve, the unit the row-by-row surface algorithms act on.
+//! - `surface`: the NURBS surface, its validation and evaluation.
+//! - `insert`: knot insertion and clamping.
+//! - `decompose`: Bézier decomposition.
+//! - `shapes`: exact torus and sphere built from the 9-point circle.
 
-use glam::{DVec3, DVec4};
+pub mod basis;
+pub mod curve;
+pub mod decompose;
+pub mod insert;
+pub mod knots;
+pub mod shapes;
+pub mod surface;
 
-use super::bezier::{BezierPatch, GeomError};
+#[cfg(test)]
+mod testutil;
 
-/// A NURBS surface with homogeneous premultiplied control points, u index fastest.
-#[derive(Clone, Debug, PartialEq)]
-pub struct NurbsSurface {
-    pub degree_u: usize,
-    pub degree_v: usize,
-    pub knots_u: Vec<f64>,
-    pub knots_v: Vec<f64>,
-    pub count_u: usize,
-    pub count_v: usize,
-    pub points: Vec<DVec4>,
-}
-
-impl NurbsSurface {
-    /// Validates and builds a surface.
-    pub fn new(
-        degree_u: usize,
-        degree_v: usize,
-        knots_u: Vec<f64>,
-        knots_v: Vec<f64>,
-        count_u: usize,
-        count_v: usize,
-        points: Vec<DVec4>,
-    ) -> Result<Self, GeomError> {
-        Ok(NurbsSurface {
-            degree_u,
-            degree_v,
-            knots_u,
-            knots_v,
-            count_u,
-            count_v,
-            points,
-        })
-    }
-
-    /// Surface point at parameters (u, v), Cox–de Boor in f64.
-    pub fn eval(&self, _u: f64, _v: f64) -> DVec3 {
-        unimplemented!("nurbs evaluation")
-    }
-
-    /// Exact decomposition into Bézier patches in span order, u spans fastest.
-    pub fn to_bezier_patches(&self) -> Vec<BezierPatch> {
-        unimplemented!("nurbs decomposition")
-    }
-
-    pub fn transform(&mut self, m: &glam::DAffine3) {
-        for p in &mut self.points {
-            let e = m.transform_point3(p.truncate() / p.w);
-            *p = (e * p.w).extend(p.w);
-        }
-    }
-}
+pub use curve::NurbsCurve;
+pub use decompose::BezierSegment;
+pub use knots::KnotError;
+pub use surface::NurbsSurface;
