@@ -361,10 +361,7 @@ impl<'a> Reader<'a, '_> {
         if !rational {
             return Ok(v.coords.extend(1.0));
         }
-        if v.weight <= 0.0 {
-            let tok = v
-                .weight_tok
-                .expect("only a written weight can be non-positive");
+        if let Some(tok) = v.weight_tok.filter(|_| v.weight <= 0.0) {
             return Err(self.error(
                 &tok,
                 format!("expected a positive weight, found `{}`", tok.text),
