@@ -462,3 +462,21 @@ fn trims_need_defined_curves() {
     let src = with_line(10, "trim 0 1 1\nend");
     assert_error(&src, 10, 10, "dangling curv2 index `1`: expected 1 to 0");
 }
+
+#[test]
+fn curve_point_counts_must_match_the_knots() {
+    let src = "vp 0 0\nvp 1 0\nvp 1 1\ncstype bspline\ndeg 1\ncurv2 1 2 3\nparm u 0 0 1 1\nend\n";
+    assert_error(
+        src,
+        7,
+        1,
+        "expected 5 values in `parm u` (3 control points + degree 1 + 1), found 4",
+    );
+    let one_d = "vp 0\nvp 1 0\ncstype bspline\ndeg 1\ncurv2 1 2\nparm u 0 0 1 1\nend\n";
+    assert_error(
+        one_d,
+        5,
+        7,
+        "expected a parameter vertex with u and v, `vp` 1 has only u",
+    );
+}
