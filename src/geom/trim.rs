@@ -3,8 +3,11 @@
 
 use glam::DVec3;
 
-/// A planar parameter-space curve (OBJ `curv2`): a B-spline or Bézier curve with
-/// homogeneous points `(u, v, w)` (w = 1 for non-rational).
+/// A planar parameter-space curve (OBJ `curv2`) as a B-spline: homogeneous premultiplied
+/// points `(w u, w v, w)` (w = 1 for non-rational) and a knot vector of
+/// `points.len() + degree + 1` values. A piecewise Bézier curve is stored as the B-spline
+/// with the same breakpoints (end knots repeated `degree + 1` times, interior ones
+/// `degree` times), which is the same curve.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ParamCurve {
     pub degree: usize,

@@ -134,6 +134,131 @@ pub fn parse_finite(path: &Path, tok: &Token, what: &str) -> Result<f64, ParseEr
     }
 }
 
+/// One logical line of a line-oriented format (OBJ): its words with their original
+/// positions, and the position just past its last character (where "found end of line"
+/// errors point).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LogicalLine<'a> {
+    pub tokens: Vec<Token<'a>>,
+    pub end: (usize, usize),
+}
+
+/// Splits a text into logical lines: `#` starts a comment to the end of the physical
+/// line, and a backslash ending a physical line joins the next one to it (the OBJ
+/// continuation rule). Each token keeps the line and column where it was written, so
+/// errors inside a continued statement point at the right physical line. Blank lines are
+/// dropped. Also returns where "found end of file" errors point: the end of the last
+/// logical line (or 1:1 for an empty text).
+pub fn logical_lines(src: &str) -> (Vec<LogicalLine<'_>>, (usize, usize)) {
+    let mut lines = Vec::new();
+    let mut current = Vec::new();
+    let mut end = (1, 1);
+    for (index, physical) in src.split('\n').enumerate() {
+        let number = index + 1;
+        let physical = physical.strip_suffix('\r').unwrap_or(physical);
+        let content = physical.split('#').next().unwrap_or("").trim_end();
+        let (content, continued) = match content.strip_suffix('\\') {
+            Some(c) => (c, true),
+            None => (content, false),
+        };
+        let mut column = 1;
+        let mut rest = content;
+        while let Some(start) = rest.find(|c: char| !c.is_whitespace()) {
+            column += rest[..start].chars().count();
+            rest = &rest[start..];
+            let len = rest.find(char::is_whitespace).unwrap_or(rest.len());
+            current.push(Token {
+                text: &rest[..len],
+                line: number,
+                column,
+            });
+            column += rest[..len].chars().count();
+            rest = &rest[len..];
+        }
+        end = (number, content.chars().count() + 1);
+        if !continued && !current.is_empty() {
+            lines.push(LogicalLine {
+                tokens: std::mem::take(&mut current),
+                end,
+            });
+        }
+    }
+    if !current.is_empty() {
+        lines.push(LogicalLine {
+            tokens: current,
+            end,
+        });
+    }
+    let eof = lines.last().map_or((1, 1), |l| l.end);
+    (lines, eof)
+}
+
+/// A cursor over the words of one logical line, with errors that name what was expected.
+pub struct Words<'l, 'a> {
+    path: &'l Path,
+    line: &'l LogicalLine<'a>,
+    next: usize,
+}
+
+impl<'l, 'a> Words<'l, 'a> {
+    pub fn new(path: &'l Path, line: &'l LogicalLine<'a>) -> Self {
+        Words {
+            path,
+            line,
+            next: 0,
+        }
+    }
+
+    /// The next word, if any.
+    pub fn next_opt(&mut self) -> Option<Token<'a>> {
+        let t = self.line.tokens.get(self.next).copied();
+        self.next += t.is_some() as usize;
+        t
+    }
+
+    /// The next word, or an error at the end of the line saying `what` was expected.
+    pub fn next(&mut self, what: &str) -> Result<Token<'a>, ParseError> {
+        self.next_opt()
+            .ok_or_else(|| self.error_at_end(format!("expected {what}, found end of line")))
+    }
+
+    /// The next word as a finite `f64`.
+    pub fn finite(&mut self, what: &str) -> Result<f64, ParseError> {
+        let tok = self.next(what)?;
+        parse_finite(self.path, &tok, what)
+    }
+
+    /// The next word, if any, as a finite `f64`.
+    pub fn finite_opt(&mut self, what: &str) -> Result<Option<(f64, Token<'a>)>, ParseError> {
+        self.next_opt()
+            .map(|tok| parse_finite(self.path, &tok, what).map(|x| (x, tok)))
+            .transpose()
+    }
+
+    /// The words not consumed yet.
+    pub fn rest(&mut self) -> &'l [Token<'a>] {
+        let rest = &self.line.tokens[self.next.min(self.line.tokens.len())..];
+        self.next = self.line.tokens.len();
+        rest
+    }
+
+    /// Fails unless every word was consumed.
+    pub fn expect_end(&mut self) -> Result<(), ParseError> {
+        match self.next_opt() {
+            None => Ok(()),
+            Some(t) => Err(self.error_at(&t, format!("expected end of line, found `{}`", t.text))),
+        }
+    }
+
+    pub fn error_at(&self, tok: &Token, message: impl Into<String>) -> ParseError {
+        ParseError::new(self.path, tok.line, tok.column, message)
+    }
+
+    pub fn error_at_end(&self, message: impl Into<String>) -> ParseError {
+        ParseError::new(self.path, self.line.end.0, self.line.end.1, message)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -159,5 +284,54 @@ mod tests {
         let e = t.finite("x coordinate").unwrap_err();
         assert_eq!((e.line, e.column), (2, 2));
         assert!(e.to_string().contains("finite"), "{e}");
+    }
+    #[test]
+    fn continued_lines_keep_their_physical_positions() {
+        let (lines, eof) = logical_lines("v 1 \\\n  2 3 # c\n\nsurf\\\n\tx\n");
+        let words: Vec<Vec<_>> = lines
+            .iter()
+            .map(|l| {
+                l.tokens
+                    .iter()
+                    .map(|t| (t.text, t.line, t.column))
+                    .collect()
+            })
+            .collect();
+        assert_eq!(
+            words,
+            vec![
+                vec![("v", 1, 1), ("1", 1, 3), ("2", 2, 3), ("3", 2, 5)],
+                vec![("surf", 4, 1), ("x", 5, 2)],
+            ]
+        );
+        assert_eq!(lines[0].end, (2, 6));
+        assert_eq!(eof, (5, 3));
+    }
+
+    #[test]
+    fn words_report_missing_and_extra_words() {
+        let (lines, _) = logical_lines("deg 3\ndeg 1 2 3");
+        let p = Path::new("a.obj");
+        let mut w = Words::new(p, &lines[0]);
+        w.next("keyword").unwrap();
+        w.next("du").unwrap();
+        let e = w.next("dv").unwrap_err();
+        assert_eq!((e.line, e.column), (1, 6));
+        assert!(
+            e.message.starts_with("expected dv, found end of line"),
+            "{e}"
+        );
+        let mut w = Words::new(p, &lines[1]);
+        w.rest();
+        assert!(w.expect_end().is_ok());
+        let mut w = Words::new(p, &lines[1]);
+        for _ in 0..3 {
+            w.next("x").unwrap();
+        }
+        let e = w.expect_end().unwrap_err();
+        assert_eq!(
+            (e.line, e.column, e.message.as_str()),
+            (2, 9, "expected end of line, found `3`")
+        );
     }
 }
