@@ -362,11 +362,11 @@ fn gltf_glb_and_obj_round_trip() {
     .unwrap();
     let m = &models[0].mesh;
     // tobj renumbers vertices, so compare each triangle's corner positions (written with
-    // full f64 precision, read back as f32 by tobj).
+    // full f64 precision, read back as f64 by tobj: bit-exact).
     assert_eq!(m.indices.len(), mesh.indices.len() * 3);
     for (k, &i) in m.indices.iter().enumerate() {
-        let read = glam::Vec3::from_slice(&m.positions[3 * i as usize..3 * i as usize + 3]);
-        let ours = mesh.positions[mesh.indices[k / 3][k % 3] as usize].as_vec3();
+        let read = glam::DVec3::from_slice(&m.positions[3 * i as usize..3 * i as usize + 3]);
+        let ours = mesh.positions[mesh.indices[k / 3][k % 3] as usize];
         assert_eq!(read, ours);
     }
 }
