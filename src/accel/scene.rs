@@ -1,15 +1,18 @@
 //! The scene as the renderer sees it: every Bézier patch prepared for the kernel in `f32`,
-//! its `f64` original kept for normals and the reference path, and a BVH over the tight
-//! patch boxes (LG90 §3.1, Fig. 2). One query answers "nearest hit" or "anything in the
-//! way" for a ray, counting the work it did.
+//! its `f64` original kept for normals and the reference path, every mesh triangle in `f32`
+//! for the watertight kernel, and one BVH over the tight patch boxes (LG90 §3.1, Fig. 2)
+//! and the triangle boxes. Primitive `i` of the BVH is patch `i` when `i` is below the
+//! patch count, and triangle `i - patch count` otherwise. One query answers "nearest hit"
+//! or "anything in the way" for a ray, counting the work it did.
 
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 
 use super::bvh::{Bvh, GeometryHasher};
 use crate::geom::{Aabb, BezierPatch, DAabb, Ray};
 use crate::kernel::subdivision::{self, PreparedPatch, SubdivisionConfig};
+use crate::kernel::triangle::{self, RayShear, TriangleHit};
 use crate::kernel::{KernelStats, PatchHit};
-use crate::scene::Scene;
+use crate::scene::{Geometry, Scene};
 
 /// Which intersection path answers queries.
 #[derive(Clone, Copy, Debug)]
@@ -49,16 +52,36 @@ pub struct SceneHit {
     /// The final box of the subdivision (the hit interval), secondary rays start at its
     /// corners (Dammertz §2.4).
     pub hit_box: Aabb,
-    /// Unit geometric normal `∂S/∂u × ∂S/∂v` at (u, v), from the exact `f64` derivatives.
+    /// Unit geometric normal: `∂S/∂u × ∂S/∂v` at (u, v) from the exact `f64` derivatives
+    /// for a patch, the face normal for a triangle.
     pub normal: DVec3,
+    /// Unit normal for shading: the geometric normal for a patch, the interpolated vertex
+    /// normal (on the geometric normal's side) for a triangle of a mesh that has them.
+    pub shading_normal: DVec3,
+}
+
+/// Mesh triangles in `f32`, with per-corner shading normals when the mesh has them.
+#[derive(Default)]
+struct Triangles {
+    corners: Vec<[Vec3; 3]>,
+    normals: Vec<Option<[DVec3; 3]>>,
+    /// (object, triangle within object).
+    ids: Vec<(u32, u32)>,
+}
+
+/// The nearest candidate found so far during traversal.
+enum Candidate {
+    Patch(u32, PatchHit),
+    Triangle(u32, TriangleHit),
 }
 
 /// Prepared geometry of a scene.
 pub struct SceneGeometry {
     prepared: Vec<PreparedPatch>,
     originals: Vec<BezierPatch>,
-    /// (object, patch within object) per primitive.
+    /// (object, patch within object) per patch.
     ids: Vec<(u32, u32)>,
+    triangles: Triangles,
     bvh: Bvh,
 }
 
@@ -66,29 +89,49 @@ impl SceneGeometry {
     /// Prepares the patches and builds the BVH.
     pub fn build(scene: &Scene) -> SceneGeometry {
         let (originals, ids) = collect_patches(scene);
+        let triangles = collect_triangles(scene);
         let boxes: Vec<Aabb> = originals
             .iter()
             .map(|p| p.tight_box().to_f32_outward())
+            .chain(
+                triangles
+                    .corners
+                    .iter()
+                    .map(|c| c.iter().copied().collect()),
+            )
             .collect();
         let bvh = Bvh::build(&boxes);
-        Self::with_bvh(originals, ids, bvh)
+        Self::with_bvh(originals, ids, triangles, bvh)
     }
 
-    fn with_bvh(originals: Vec<BezierPatch>, ids: Vec<(u32, u32)>, bvh: Bvh) -> SceneGeometry {
+    fn with_bvh(
+        originals: Vec<BezierPatch>,
+        ids: Vec<(u32, u32)>,
+        triangles: Triangles,
+        bvh: Bvh,
+    ) -> SceneGeometry {
         let prepared = originals.iter().map(PreparedPatch::new).collect();
         SceneGeometry {
             prepared,
             originals,
             ids,
+            triangles,
             bvh,
         }
     }
 
-    /// A hash of the geometry the BVH indexes: degrees and control points in file order.
-    /// A BVH file records it so that a stale file is refused.
+    /// A hash of the geometry the BVH indexes: degrees and control points in file order,
+    /// then triangle corners. A BVH file records it so that a stale file is refused.
     pub fn hash_scene(scene: &Scene) -> u64 {
         let mut h = GeometryHasher::new();
         let (patches, _) = collect_patches(scene);
+        let triangles = collect_triangles(scene);
+        h.write_u64(triangles.corners.len() as u64);
+        for c in triangles.corners.iter().flatten() {
+            for x in c.to_array() {
+                h.write_f64(x as f64);
+            }
+        }
         h.write_u64(patches.len() as u64);
         for p in &patches {
             h.write_u64(p.degree_u() as u64);
@@ -108,6 +151,10 @@ impl SceneGeometry {
 
     pub fn patch_count(&self) -> usize {
         self.prepared.len()
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.corners.len()
     }
 
     pub fn bounds(&self) -> Aabb {
@@ -136,23 +183,41 @@ impl SceneGeometry {
         cfg: &SubdivisionConfig,
         stats: &mut QueryStats,
     ) -> Option<SceneHit> {
-        let mut best: Option<(u32, PatchHit)> = None;
+        let mut best: Option<Candidate> = None;
         let mut kernel = KernelStats::default();
+        let shear = RayShear::new(ray);
+        let patches = self.prepared.len() as u32;
         let t = self.bvh.traverse(ray, |prim, tmax| {
-            let r = Ray { tmax, ..*ray };
-            let hit = subdivision::intersect(&self.prepared[prim as usize], &r, cfg, &mut kernel)?;
-            best = Some((prim, hit));
-            Some(hit.t)
+            kernel.patch_tests += (prim >= patches) as u64;
+            if prim < patches {
+                let r = Ray { tmax, ..*ray };
+                let hit =
+                    subdivision::intersect(&self.prepared[prim as usize], &r, cfg, &mut kernel)?;
+                best = Some(Candidate::Patch(prim, hit));
+                Some(hit.t)
+            } else {
+                let k = prim - patches;
+                let [a, b, c] = self.triangles.corners[k as usize];
+                let hit = triangle::intersect_triangle(&shear, a, b, c, ray.tmin, tmax)?;
+                best = Some(Candidate::Triangle(k, hit));
+                Some(hit.t)
+            }
         });
         stats.kernel.add(&kernel);
         stats.nodes_visited += t.nodes_visited;
         stats.bvh_box_tests += t.box_tests;
-        let (prim, h) = best?;
-        Some(self.finish_hit(prim, h.t as f64, h.u as f64, h.v as f64, h.hit_box))
+        Some(match best? {
+            Candidate::Patch(prim, h) => {
+                self.finish_patch_hit(prim, h.t as f64, h.u as f64, h.v as f64, h.hit_box)
+            }
+            Candidate::Triangle(k, h) => self.finish_triangle_hit(k, &h),
+        })
     }
 
     /// The `f64` reference: every patch whose box the ray meets (an `f64` slab test, so no
-    /// `f32` rounding of the ray can drop a candidate) is intersected in `f64`.
+    /// `f32` rounding of the ray can drop a candidate) is intersected in `f64`. Triangles
+    /// are flat already; they are intersected by the watertight kernel on the ray rounded
+    /// to `f32`.
     pub fn intersect_f64(
         &self,
         origin: DVec3,
@@ -180,8 +245,27 @@ impl SceneGeometry {
                 best = Some((prim as u32, h));
             }
         }
+        let ray = Ray {
+            origin: origin.as_vec3(),
+            dir: dir.as_vec3(),
+            tmin: tmin as f32,
+            tmax: best.as_ref().map_or(tmax, |(_, h)| h.t) as f32,
+        };
+        let mut nearest_triangle = None;
+        let shear = RayShear::new(&ray);
+        let mut limit = ray.tmax;
+        for (k, [a, b, c]) in self.triangles.corners.iter().enumerate() {
+            stats.kernel.patch_tests += 1;
+            if let Some(h) = triangle::intersect_triangle(&shear, *a, *b, *c, ray.tmin, limit) {
+                limit = h.t;
+                nearest_triangle = Some((k as u32, h));
+            }
+        }
+        if let Some((k, h)) = nearest_triangle {
+            return Some(self.finish_triangle_hit(k, &h));
+        }
         let (prim, h) = best?;
-        Some(self.finish_hit(prim, h.t, h.u, h.v, h.hit_box.to_f32_outward()))
+        Some(self.finish_patch_hit(prim, h.t, h.u, h.v, h.hit_box.to_f32_outward()))
     }
 
     /// True when anything blocks `ray` in `[tmin, tmax]` (shadow rays).
@@ -189,8 +273,16 @@ impl SceneGeometry {
         match precision {
             Precision::F32(cfg) => {
                 let mut kernel = KernelStats::default();
+                let patches = self.prepared.len() as u32;
+                let shear = RayShear::new(ray);
                 let (hit, t) = self.bvh.traverse_any(ray, |prim| {
-                    subdivision::occluded(&self.prepared[prim as usize], ray, cfg, &mut kernel)
+                    if prim < patches {
+                        subdivision::occluded(&self.prepared[prim as usize], ray, cfg, &mut kernel)
+                    } else {
+                        kernel.patch_tests += 1;
+                        let [a, b, c] = self.triangles.corners[(prim - patches) as usize];
+                        triangle::intersect_triangle(&shear, a, b, c, ray.tmin, ray.tmax).is_some()
+                    }
                 });
                 stats.kernel.add(&kernel);
                 stats.nodes_visited += t.nodes_visited;
@@ -201,8 +293,9 @@ impl SceneGeometry {
         }
     }
 
-    fn finish_hit(&self, prim: u32, t: f64, u: f64, v: f64, hit_box: Aabb) -> SceneHit {
+    fn finish_patch_hit(&self, prim: u32, t: f64, u: f64, v: f64, hit_box: Aabb) -> SceneHit {
         let (object, patch) = self.ids[prim as usize];
+        let normal = self.originals[prim as usize].normal(u, v);
         SceneHit {
             t,
             object,
@@ -210,7 +303,36 @@ impl SceneGeometry {
             u,
             v,
             hit_box,
-            normal: self.originals[prim as usize].normal(u, v),
+            normal,
+            shading_normal: normal,
+        }
+    }
+
+    /// A triangle hit: (u, v) are the barycentric weights of corners 1 and 2, the hit box
+    /// bounds the rounding of the hit point (pbrt-v3 §3.9.5) so secondary rays leave from
+    /// its corners like from a patch's final box.
+    fn finish_triangle_hit(&self, k: u32, h: &TriangleHit) -> SceneHit {
+        let [a, b, c] = self.triangles.corners[k as usize];
+        let (object, index) = self.triangles.ids[k as usize];
+        let (da, db, dc) = (a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
+        let normal = (db - da).cross(dc - da).normalize_or(DVec3::Z);
+        let shading_normal = match self.triangles.normals[k as usize] {
+            Some([na, nb, nc]) => {
+                let n =
+                    (na * h.b0 as f64 + nb * h.b1 as f64 + nc * h.b2 as f64).normalize_or(normal);
+                if n.dot(normal) < 0.0 { -n } else { n }
+            }
+            None => normal,
+        };
+        SceneHit {
+            t: h.t as f64,
+            object,
+            patch: index,
+            u: h.b1 as f64,
+            v: h.b2 as f64,
+            hit_box: triangle::hit_box(h, a, b, c),
+            normal,
+            shading_normal,
         }
     }
 }
@@ -241,13 +363,14 @@ impl SceneGeometry {
         let bvh = Bvh::read(&mut reader, Self::hash_scene(scene))
             .map_err(|e| LoadError::invalid(path, e.to_string()))?;
         let (originals, ids) = collect_patches(scene);
-        if bvh.prim_count() != originals.len() {
+        let triangles = collect_triangles(scene);
+        if bvh.prim_count() != originals.len() + triangles.corners.len() {
             return Err(LoadError::invalid(
                 path,
                 "the BVH indexes a different number of patches than the scene; rebuild it with `patchtrace bvh`",
             ));
         }
-        Ok(Self::with_bvh(originals, ids, bvh))
+        Ok(Self::with_bvh(originals, ids, triangles, bvh))
     }
 
     /// Writes the BVH with the scene's geometry hash, atomically.
@@ -259,4 +382,23 @@ impl SceneGeometry {
         let hash = Self::hash_scene(scene);
         crate::scene::write::write_atomic(path, |w| self.bvh.write(w, hash))
     }
+}
+
+/// All mesh triangles of the scene in object order, rounded to `f32`.
+fn collect_triangles(scene: &Scene) -> Triangles {
+    let mut t = Triangles::default();
+    for (o, object) in scene.objects.iter().enumerate() {
+        let Geometry::Mesh(mesh) = &object.geometry else {
+            continue;
+        };
+        let has_normals = mesh.normals.len() == mesh.positions.len();
+        for (k, idx) in mesh.indices.iter().enumerate() {
+            let [a, b, c] = idx.map(|i| mesh.positions[i as usize]);
+            t.corners.push([a.as_vec3(), b.as_vec3(), c.as_vec3()]);
+            t.normals
+                .push(has_normals.then(|| idx.map(|i| mesh.normals[i as usize])));
+            t.ids.push((o as u32, k as u32));
+        }
+    }
+    t
 }

@@ -27,6 +27,8 @@ pub enum Command {
     Render(RenderArgs),
     /// Nearest hit per ray from a ray file, as CSV.
     Trace(TraceArgs),
+    /// Tessellate free-form surfaces into a triangle mesh (OBJ, glTF or GLB).
+    Tessellate(TessellateArgs),
     /// Generate test scenes.
     #[command(subcommand)]
     Scene(SceneCommand),
@@ -193,4 +195,37 @@ pub struct BvhArgs {
     /// Output BVH file.
     #[arg(short, long)]
     pub output: PathBuf,
+}
+
+#[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("mode").args(["triangles_per_patch", "grid", "tolerance"])))]
+pub struct TessellateArgs {
+    /// Scene (.ron) or bare geometry.
+    pub scene: PathBuf,
+    /// Output mesh: .obj, .gltf (buffer embedded) or .glb.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Uniform grid per patch with this many triangles (an even number 2·u·v, e.g. 512,
+    /// 4608 or 131072 as in Dammertz Tables 2.1–2.4). The default mode, with 512.
+    #[arg(long, value_name = "N")]
+    pub triangles_per_patch: Option<u32>,
+    /// Uniform grid of U×V quads per patch.
+    #[arg(long, value_name = "U,V", value_parser = parse_grid)]
+    pub grid: Option<(u32, u32)>,
+    /// Adaptive, crack-free tessellation with this chord-height tolerance (scene units).
+    #[arg(long, value_name = "DISTANCE")]
+    pub tolerance: Option<f64>,
+    /// Print the report as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_grid(s: &str) -> Result<(u32, u32), String> {
+    let (u, v) = s.split_once(',').ok_or("expected U,V such as 16,16")?;
+    let p = |x: &str| {
+        x.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("expected a whole number, found `{x}`"))
+    };
+    Ok((p(u)?, p(v)?))
 }

@@ -12,6 +12,7 @@ pub mod man;
 mod render;
 mod scene_gen;
 mod setup;
+mod tessellate;
 pub mod trace;
 
 use std::process::ExitCode;
@@ -54,6 +55,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Bvh(a) => bvh::run(a),
         Command::Render(a) => render::run(a),
         Command::Trace(a) => trace::run(a),
+        Command::Tessellate(a) => tessellate::run(a),
         Command::Scene(args::SceneCommand::Teapots(a)) => scene_gen::teapots(a),
     }
 }

@@ -52,16 +52,24 @@ impl Integrator<'_> {
         let m = &self.scene.materials[object.material];
         let d = ray.dir.normalize();
         let n_geo = hit.normal.as_vec3();
-        // Two-sided: shade with the normal on the side the ray came from.
+        // Two-sided: the side the ray came from decides by the geometric normal; shading
+        // uses the shading normal turned to that side, secondary rays leave by the
+        // geometric one so they really leave the surface.
         let outside = n_geo.dot(d) < 0.0;
-        let n = if outside { n_geo } else { -n_geo };
+        let n_out = if outside { n_geo } else { -n_geo };
+        let n_shade = hit.shading_normal.as_vec3();
+        let n = if n_shade.dot(n_out) < 0.0 {
+            -n_shade
+        } else {
+            n_shade
+        };
         let view = -d;
         let plan = &self.settings.plan;
         let ulps = self.settings.ulps;
         let opaque = 1.0 - m.transmit.min(1.0);
 
         let mut color = self.scene.ambient * m.diffuse * opaque;
-        let above = secondary_origin(&hit.hit_box, n, true, ulps);
+        let above = secondary_origin(&hit.hit_box, n_out, true, ulps);
         for light in &self.scene.lights {
             let (to_light, tmax, intensity) = match *light {
                 Light::Point {
@@ -113,20 +121,23 @@ impl Integrator<'_> {
                 color += m.reflect * self.radiance(&r, RayKind::Reflection, depth + 1, tally).0;
             }
             if m.transmit > 0.0 && plan.refraction {
-                color +=
-                    m.transmit * self.transmitted(d, n, outside, m.ior, &hit.hit_box, depth, tally);
+                let through =
+                    self.transmitted(d, n, n_out, outside, m.ior, &hit.hit_box, depth, tally);
+                color += m.transmit * through;
             }
         }
         (color, true)
     }
 
     /// Light through a transmissive surface: refraction weighted by 1 − Fresnel, plus the
-    /// Fresnel reflection; all reflection under total internal reflection.
+    /// Fresnel reflection; all reflection under total internal reflection. `n` is the
+    /// shading normal and `n_out` the geometric one, both on the incoming side.
     #[allow(clippy::too_many_arguments)]
     fn transmitted(
         &self,
         d: Vec3,
         n: Vec3,
+        n_out: Vec3,
         entering: bool,
         ior: f32,
         hit_box: &crate::geom::Aabb,
@@ -137,7 +148,7 @@ impl Integrator<'_> {
         let eta = if entering { 1.0 / ior } else { ior };
         let cos_i = -d.dot(n);
         let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
-        let reflected = Ray::new(secondary_origin(hit_box, n, true, ulps), reflect(d, n));
+        let reflected = Ray::new(secondary_origin(hit_box, n_out, true, ulps), reflect(d, n));
         if k < 0.0 {
             return self
                 .radiance(&reflected, RayKind::Reflection, depth + 1, tally)
@@ -147,7 +158,7 @@ impl Integrator<'_> {
         // Schlick uses the cosine on the optically thinner side.
         let cos = if entering { cos_i } else { k.sqrt() };
         let f = schlick(cos, ior);
-        let refracted = Ray::new(secondary_origin(hit_box, n, false, ulps), t_dir);
+        let refracted = Ray::new(secondary_origin(hit_box, n_out, false, ulps), t_dir);
         let through = self
             .radiance(&refracted, RayKind::Refraction, depth + 1, tally)
             .0;

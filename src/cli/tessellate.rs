@@ -1,0 +1,79 @@
+//! `patchtrace tessellate SCENE -o OUT.obj|OUT.gltf|OUT.glb`: the triangle baseline.
+
+use std::io::Write;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::cli::args::TessellateArgs;
+use crate::scene::{LoadError, load_scene};
+use crate::tessellate::{
+    MeshFormat, TessellationMode, TessellationReport, tessellate_scene, write_mesh_scene,
+};
+
+/// Triangles per patch when no mode is given: Dammertz's coarsest table row.
+const DEFAULT_TRIANGLES_PER_PATCH: u32 = 512;
+
+#[derive(Serialize)]
+struct Report {
+    #[serde(flatten)]
+    mesh: TessellationReport,
+    file_bytes: u64,
+    seconds: f64,
+}
+
+/// The mode chosen by the flags (clap makes them mutually exclusive).
+pub fn mode(args: &TessellateArgs) -> TessellationMode {
+    match (args.grid, args.tolerance) {
+        (Some((u, v)), _) => TessellationMode::Uniform {
+            grid_u: u,
+            grid_v: v,
+        },
+        (_, Some(t)) => TessellationMode::Adaptive { tolerance: t },
+        _ => TessellationMode::TrianglesPerPatch(
+            args.triangles_per_patch
+                .unwrap_or(DEFAULT_TRIANGLES_PER_PATCH),
+        ),
+    }
+}
+
+pub fn run(args: TessellateArgs) -> anyhow::Result<ExitCode> {
+    if MeshFormat::of(&args.output).is_none() {
+        return Err(LoadError::invalid(
+            &args.output,
+            "unsupported mesh type: expected .obj, .gltf or .glb",
+        )
+        .into());
+    }
+    let scene = load_scene(&args.scene)?;
+    let start = Instant::now();
+    let (meshes, report) = tessellate_scene(&scene, mode(&args))?;
+    let seconds = start.elapsed().as_secs_f64();
+    let file_bytes = write_mesh_scene(&args.output, &meshes)?;
+    let r = Report {
+        mesh: report,
+        file_bytes,
+        seconds,
+    };
+    let mut out = std::io::stdout().lock();
+    if args.json {
+        writeln!(out, "{}", serde_json::to_string_pretty(&r)?)?;
+    } else {
+        writeln!(out, "triangles: {}", r.mesh.triangles)?;
+        writeln!(out, "vertices:  {}", r.mesh.vertices)?;
+        writeln!(
+            out,
+            "memory:    {} bytes (f32 positions and normals, u32 indices)",
+            r.mesh.bytes
+        )?;
+        writeln!(
+            out,
+            "file:      {} bytes, {}",
+            r.file_bytes,
+            args.output.display()
+        )?;
+        writeln!(out, "time:      {:.3} s", r.seconds)?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
