@@ -1,1 +1,116 @@
-//! PLACEHOLDER for the Dammertz subdivision kernel.
+//! The Dammertz subdivision kernel (Dammertz 2005, §2.2–2.3, §2.5.2, §2.7): intersect a ray
+//! with a Bézier patch by splitting it at 1/2 with de Casteljau's algorithm until its
+//! bounding box stops shrinking in `f32`. The final box is the hit interval (§2.2); the hit
+//! reports `t` at the box entry and (u, v) at the centre of the box's parameter cell.
+//!
+//! - [`search`]: the stack-based search, once for every net storage and precision.
+//! - [`bicubic`]: the SIMD fast path for bicubic integral patches.
+//! - [`general`]: any degree up to 15, rational patches (homogeneous nets, §2.7.2).
+//! - [`reference`]: the same algorithm in `f64`, the accuracy reference (§2.3.4).
+//! - [`heuristics`], [`config`], [`param`], [`float`]: split direction, settings,
+//!   parameter cells (and the depth bound that guarantees termination), scalar types.
+//!
+//! No fixed epsilon appears anywhere: termination is the box's own precision (the L1
+//! diameter stops shrinking, or for rational patches the box corners come within
+//! `rational_dist` ulps), and depth is bounded by the parameter cell ([`param`]).
+
+pub mod bicubic;
+pub mod config;
+pub mod float;
+pub mod general;
+pub mod heuristics;
+pub mod param;
+pub mod prepared;
+pub mod reference;
+pub mod search;
+
+use std::cell::RefCell;
+
+pub use config::{DEFAULT_RATIONAL_DIST, SplitHeuristic, SubdivisionConfig};
+pub use prepared::PreparedPatch;
+pub use reference::{PatchHit64, intersect_f64};
+
+use bicubic::{BicubicStack, Net};
+use float::{GBox, GRay};
+use general::{GeneralStack, Scratch};
+use prepared::Prepared;
+use search::{SearchHit, search};
+
+use crate::geom::Ray;
+use crate::kernel::{KernelStats, PatchHit};
+
+thread_local! {
+    /// Per-thread buffers of the bicubic path: the pushed nets and the search nodes.
+    static BICUBIC_SCRATCH: RefCell<(Vec<Net>, Vec<search::Node<f32>>)> =
+        const { RefCell::new((Vec::new(), Vec::new())) };
+    /// Per-thread buffers of the general path.
+    static GENERAL_SCRATCH: RefCell<Scratch<f32>> = RefCell::new(Scratch::default());
+}
+
+/// Nearest hit with `t` in `[ray.tmin, ray.tmax]`; `ray.tmax` is the current closest hit.
+pub fn intersect(
+    patch: &PreparedPatch,
+    ray: &Ray,
+    cfg: &SubdivisionConfig,
+    stats: &mut KernelStats,
+) -> Option<PatchHit> {
+    run(patch, ray, cfg, false, stats).map(|h| {
+        let (u, v) = h.cell.centre();
+        PatchHit {
+            t: h.t,
+            u: u as f32,
+            v: v as f32,
+            hit_box: h.bbox.to_aabb(),
+        }
+    })
+}
+
+/// Any hit in `[ray.tmin, ray.tmax]` (shadow rays): stops at the first final box found.
+pub fn occluded(
+    patch: &PreparedPatch,
+    ray: &Ray,
+    cfg: &SubdivisionConfig,
+    stats: &mut KernelStats,
+) -> bool {
+    run(patch, ray, cfg, true, stats).is_some()
+}
+
+fn run(
+    patch: &PreparedPatch,
+    ray: &Ray,
+    cfg: &SubdivisionConfig,
+    any_hit: bool,
+    stats: &mut KernelStats,
+) -> Option<SearchHit<f32>> {
+    let gray = GRay::new(
+        ray.origin.to_array(),
+        ray.dir.to_array(),
+        ray.tmin,
+        ray.tmax,
+    );
+    let root = GBox::from_aabb(patch.bounds);
+    match &patch.data {
+        Prepared::Bicubic(net) => BICUBIC_SCRATCH.with_borrow_mut(|(pushed, nodes)| {
+            pushed.clear();
+            let mut nets = BicubicStack {
+                cur: *net,
+                upper: *net,
+                pushed,
+            };
+            search(&mut nets, nodes, root, &gray, false, cfg, any_hit, stats)
+        }),
+        Prepared::General { net, shape } => GENERAL_SCRATCH.with_borrow_mut(|s| {
+            let mut nets = GeneralStack::new(&mut s.nets, net, *shape);
+            search(
+                &mut nets,
+                &mut s.nodes,
+                root,
+                &gray,
+                shape.rational,
+                cfg,
+                any_hit,
+                stats,
+            )
+        }),
+    }
+}
