@@ -3,7 +3,8 @@
 //! `f64` reference are collected first; then `intersect` is timed over them, single
 //! threaded, median of several runs after a warm-up.
 //!
-//! `cargo bench --bench kernel` (optionally `-- length|cross [rational_dist]`).
+//! `cargo bench --bench kernel` (optionally `-- cross` for the cross-product heuristic,
+//! `size=N` for an N² image, e.g. under callgrind).
 
 use std::path::Path;
 use std::time::Instant;
@@ -29,23 +30,25 @@ fn main() {
     if args.iter().any(|a| a == "cross") {
         cfg.heuristic = SplitHeuristic::CrossProduct;
     }
-    if let Some(d) = args.iter().find_map(|a| a.parse::<u32>().ok()) {
-        cfg.rational_dist = d;
-    }
-    let patches = read_bpt(Path::new("testdata/teapot.bpt")).expect("testdata/teapot.bpt");
+    let size: u32 = args
+        .iter()
+        .find_map(|a| a.strip_prefix("size=")?.parse().ok())
+        .unwrap_or(512);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("testdata/teapot.bpt");
+    let patches = read_bpt(&path).expect("testdata/teapot.bpt");
     let prepared: Vec<PreparedPatch> = patches.iter().map(PreparedPatch::new).collect();
     let cam = CameraRays::new(&Camera {
         eye: DVec3::new(0.0, -8.0, 4.5),
         look_at: DVec3::new(0.0, 0.0, 1.2),
         up: DVec3::Z,
         fov_y: 40.0,
-        width: 512,
-        height: 512,
+        width: size,
+        height: size,
     });
     let t0 = Instant::now();
     let mut pairs = Vec::new();
-    for y in 0..512 {
-        for x in 0..512 {
+    for y in 0..size {
+        for x in 0..size {
             let ray = cam.ray(x, y);
             let inv = ray.dir.recip();
             for (k, p) in prepared.iter().enumerate() {

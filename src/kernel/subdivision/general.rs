@@ -24,7 +24,7 @@ pub struct NetShape {
 }
 
 impl NetShape {
-    pub fn len(&self) -> usize {
+    pub fn point_count(&self) -> usize {
         self.nu * self.nv
     }
 }
@@ -114,7 +114,7 @@ impl<'a, T: KernelFloat> GeneralStack<'a, T> {
     /// Prepares `scratch` for `net` (growing it only the first time) and puts `net` in
     /// slot 0.
     pub fn new(scratch: &'a mut Vec<[T; 4]>, net: &[[T; 4]], shape: NetShape) -> Self {
-        let n = shape.len();
+        let n = shape.point_count();
         let need = (2 * T::MAX_LEVEL as usize + 2) * n;
         if scratch.len() < need {
             scratch.resize(need, [T::ZERO; 4]);
@@ -128,7 +128,7 @@ impl<'a, T: KernelFloat> GeneralStack<'a, T> {
     }
 
     fn slot(&self, k: usize) -> &[[T; 4]] {
-        let n = self.shape.len();
+        let n = self.shape.point_count();
         &self.nets[k * n..(k + 1) * n]
     }
 
@@ -153,7 +153,7 @@ impl<T: KernelFloat> NetStack<T> for GeneralStack<'_, T> {
     }
 
     fn split(&mut self, dir: Split) -> [GBox<T>; 2] {
-        let n = self.shape.len();
+        let n = self.shape.point_count();
         let (lower, upper) = self.nets[self.top * n..(self.top + 2) * n].split_at_mut(n);
         split_net(lower, upper, self.shape, dir);
         [
@@ -165,7 +165,7 @@ impl<T: KernelFloat> NetStack<T> for GeneralStack<'_, T> {
     fn push_far(&mut self, far_is_lower: bool) {
         // The pushed net must stay in the current slot and the continued one go above it.
         if !far_is_lower {
-            let n = self.shape.len();
+            let n = self.shape.point_count();
             let (lower, upper) = self.nets[self.top * n..(self.top + 2) * n].split_at_mut(n);
             lower.swap_with_slice(upper);
         }
@@ -174,7 +174,7 @@ impl<T: KernelFloat> NetStack<T> for GeneralStack<'_, T> {
 
     fn keep(&mut self, lower: bool) {
         if !lower {
-            let n = self.shape.len();
+            let n = self.shape.point_count();
             let k = self.top * n;
             self.nets.copy_within(k + n..k + 2 * n, k);
         }

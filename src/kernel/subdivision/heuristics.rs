@@ -64,7 +64,7 @@ mod tests {
 
     #[test]
     fn length_never_splits_a_collapsed_edge() {
-        let c = corners([0.0; 3], [0.0, 1e-30, 0.0]);
+        let c = corners([0.0; 3], [0.0, f64::MIN_POSITIVE, 0.0]);
         assert_eq!(
             choose(SplitHeuristic::Length, &c, [1.0, 0.0, 0.0]),
             Split::V
