@@ -3,6 +3,7 @@
 //!
 //! - [`subdivision`]: Dammertz 2005 §2.2–2.3 and §2.7: subdivide until the bounding box
 //!   stops shrinking in `f32`, with an `f64` twin that is the accuracy reference.
+//! - [`secondary`]: origins of secondary rays at hit-box corners, §2.4.
 
 pub mod secondary;
 pub mod subdivision;

@@ -1,128 +1,116 @@
-//! STAND-IN until the real kernel lands: a slow f64 subdivision with the final API.
+//! The Dammertz subdivision kernel (Dammertz 2005, §2.2–2.3, §2.5.2, §2.7): intersect a ray
+//! with a Bézier patch by splitting it at 1/2 with de Casteljau's algorithm until its
+//! bounding box stops shrinking in `f32`. The final box is the hit interval (§2.2); the hit
+//! reports `t` at the box entry and (u, v) at the centre of the box's parameter cell.
+//!
+//! - [`search`]: the stack-based search, once for every net storage and precision.
+//! - [`bicubic`]: the SIMD fast path for bicubic integral patches.
+//! - [`general`]: any degree up to 15, rational patches (homogeneous nets, §2.7.2).
+//! - [`reference`]: the same algorithm in `f64`, the accuracy reference (§2.3.4).
+//! - [`heuristics`], [`config`], [`param`], [`float`]: split direction, settings,
+//!   parameter cells (and the depth bound that guarantees termination), scalar types.
+//!
+//! No fixed epsilon appears anywhere: termination is the box's own precision (the L1
+//! diameter stops shrinking, or for rational patches the box corners come within
+//! `rational_dist` ulps), and depth is bounded by the parameter cell ([`param`]).
 
-use glam::DVec3;
+pub mod bicubic;
+pub mod config;
+pub mod float;
+pub mod general;
+pub mod heuristics;
+pub mod param;
+pub mod prepared;
+pub mod reference;
+pub mod search;
 
-use crate::geom::bbox::DAabb;
-use crate::geom::{Aabb, BezierPatch, Ray};
+use std::cell::RefCell;
+
+pub use config::{DEFAULT_RATIONAL_DIST, SplitHeuristic, SubdivisionConfig};
+pub use prepared::PreparedPatch;
+pub use reference::{PatchHit64, intersect_f64};
+
+use bicubic::{BicubicStack, Net};
+use float::{GBox, GRay};
+use general::{GeneralStack, Scratch};
+use prepared::Prepared;
+use search::{SearchHit, search};
+
+use crate::geom::Ray;
 use crate::kernel::{KernelStats, PatchHit};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SplitHeuristic {
-    Length,
-    CrossProduct,
+thread_local! {
+    /// Per-thread buffers of the bicubic path: the pushed nets and the search nodes.
+    static BICUBIC_SCRATCH: RefCell<(Vec<Net>, Vec<search::Node<f32>>)> =
+        const { RefCell::new((Vec::new(), Vec::new())) };
+    /// Per-thread buffers of the general path.
+    static GENERAL_SCRATCH: RefCell<Scratch<f32>> = RefCell::new(Scratch::default());
 }
 
-#[derive(Clone, Copy, Debug)]
-pub struct SubdivisionConfig {
-    pub heuristic: SplitHeuristic,
-    pub rational_dist: u32,
-}
-
-impl Default for SubdivisionConfig {
-    fn default() -> Self {
-        SubdivisionConfig {
-            heuristic: SplitHeuristic::Length,
-            rational_dist: 16,
-        }
-    }
-}
-
-pub struct PreparedPatch {
-    patch: BezierPatch,
-    bounds: Aabb,
-}
-
-impl PreparedPatch {
-    pub fn new(patch: &BezierPatch) -> PreparedPatch {
-        PreparedPatch {
-            patch: patch.clone(),
-            bounds: patch.control_box().to_f32_outward(),
-        }
-    }
-    pub fn bounds(&self) -> Aabb {
-        self.bounds
-    }
-}
-
-pub struct PatchHit64 {
-    pub t: f64,
-    pub u: f64,
-    pub v: f64,
-    pub hit_box: DAabb,
-}
-
+/// Nearest hit with `t` in `[ray.tmin, ray.tmax]`; `ray.tmax` is the current closest hit.
 pub fn intersect(
-    p: &PreparedPatch,
+    patch: &PreparedPatch,
     ray: &Ray,
     cfg: &SubdivisionConfig,
     stats: &mut KernelStats,
 ) -> Option<PatchHit> {
-    stats.patch_tests += 1;
-    let h = intersect_f64(
-        &p.patch,
-        ray.origin.as_dvec3(),
-        ray.dir.as_dvec3(),
-        ray.tmin as f64,
-        ray.tmax as f64,
-        cfg,
-    )?;
-    Some(PatchHit {
-        t: h.t as f32,
-        u: h.u as f32,
-        v: h.v as f32,
-        hit_box: h.hit_box.to_f32_outward(),
+    run(patch, ray, cfg, false, stats).map(|h| {
+        let (u, v) = h.cell.centre();
+        PatchHit {
+            t: h.t,
+            u: u as f32,
+            v: v as f32,
+            hit_box: h.bbox.to_aabb(),
+        }
     })
 }
 
+/// Any hit in `[ray.tmin, ray.tmax]` (shadow rays): stops at the first final box found.
 pub fn occluded(
-    p: &PreparedPatch,
+    patch: &PreparedPatch,
     ray: &Ray,
     cfg: &SubdivisionConfig,
     stats: &mut KernelStats,
 ) -> bool {
-    intersect(p, ray, cfg, stats).is_some()
+    run(patch, ray, cfg, true, stats).is_some()
 }
 
-pub fn intersect_f64(
-    patch: &BezierPatch,
-    o: DVec3,
-    d: DVec3,
-    tmin: f64,
-    tmax: f64,
-    _cfg: &SubdivisionConfig,
-) -> Option<PatchHit64> {
-    let mut best: Option<PatchHit64> = None;
-    let mut stack = vec![(patch.clone(), 0u32)];
-    let inv = d.recip();
-    while let Some((p, depth)) = stack.pop() {
-        let b = p.control_box();
-        let t0 = (b.min - o) * inv;
-        let t1 = (b.max - o) * inv;
-        let enter = t0.min(t1).max_element().max(tmin);
-        let exit = t0
-            .max(t1)
-            .min_element()
-            .min(best.as_ref().map_or(tmax, |h| h.t));
-        if enter > exit {
-            continue;
-        }
-        if depth >= 40 {
-            let dom = p.domain();
-            best = Some(PatchHit64 {
-                t: enter,
-                u: 0.5 * (dom.u0 + dom.u1),
-                v: 0.5 * (dom.v0 + dom.v1),
-                hit_box: b,
-            });
-            continue;
-        }
-        let (a, c) = if depth % 2 == 0 {
-            p.split_u()
-        } else {
-            p.split_v()
-        };
-        stack.push((c, depth + 1));
-        stack.push((a, depth + 1));
+fn run(
+    patch: &PreparedPatch,
+    ray: &Ray,
+    cfg: &SubdivisionConfig,
+    any_hit: bool,
+    stats: &mut KernelStats,
+) -> Option<SearchHit<f32>> {
+    let gray = GRay::new(
+        ray.origin.to_array(),
+        ray.dir.to_array(),
+        ray.tmin,
+        ray.tmax,
+    );
+    let root = GBox::from_aabb(patch.bounds);
+    match &patch.data {
+        Prepared::Bicubic(net) => BICUBIC_SCRATCH.with_borrow_mut(|(pushed, nodes)| {
+            pushed.clear();
+            let mut nets = BicubicStack {
+                cur: *net,
+                upper: *net,
+                pushed,
+            };
+            search(&mut nets, nodes, root, &gray, false, cfg, any_hit, stats)
+        }),
+        Prepared::General { net, shape } => GENERAL_SCRATCH.with_borrow_mut(|s| {
+            let mut nets = GeneralStack::new(&mut s.nets, net, *shape);
+            search(
+                &mut nets,
+                &mut s.nodes,
+                root,
+                &gray,
+                shape.rational,
+                cfg,
+                any_hit,
+                stats,
+            )
+        }),
     }
-    best
 }

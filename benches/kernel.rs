@@ -1,0 +1,116 @@
+//! Throughput of the `f32` subdivision kernel on the teapot's primary rays (the view of
+//! DESIGN.md's sample scene, 512²). The (ray, patch) pairs whose ray hits the patch by the
+//! `f64` reference are collected first; then `intersect` is timed over them, single
+//! threaded, median of several runs after a warm-up.
+//!
+//! `cargo bench --bench kernel` (optionally `-- cross` for the cross-product heuristic,
+//! `size=N` for an N² image, e.g. under callgrind).
+
+use std::path::Path;
+use std::time::Instant;
+
+use glam::DVec3;
+use patchtrace::kernel::KernelStats;
+use patchtrace::kernel::subdivision::{
+    PreparedPatch, SplitHeuristic, SubdivisionConfig, intersect, intersect_f64,
+};
+use patchtrace::render::camera::CameraRays;
+use patchtrace::scene::Camera;
+use patchtrace::scene::bpt::read_bpt;
+
+/// Timed runs after the warm-up; the median is reported.
+const RUNS: usize = 7;
+
+fn main() {
+    let args: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| a != "--bench")
+        .collect();
+    let mut cfg = SubdivisionConfig::default();
+    if args.iter().any(|a| a == "cross") {
+        cfg.heuristic = SplitHeuristic::CrossProduct;
+    }
+    let size: u32 = args
+        .iter()
+        .find_map(|a| a.strip_prefix("size=")?.parse().ok())
+        .unwrap_or(512);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("testdata/teapot.bpt");
+    let patches = read_bpt(&path).expect("testdata/teapot.bpt");
+    let prepared: Vec<PreparedPatch> = patches.iter().map(PreparedPatch::new).collect();
+    let cam = CameraRays::new(&Camera {
+        eye: DVec3::new(0.0, -8.0, 4.5),
+        look_at: DVec3::new(0.0, 0.0, 1.2),
+        up: DVec3::Z,
+        fov_y: 40.0,
+        width: size,
+        height: size,
+    });
+    let t0 = Instant::now();
+    let mut pairs = Vec::new();
+    for y in 0..size {
+        for x in 0..size {
+            let ray = cam.ray(x, y);
+            let inv = ray.dir.recip();
+            for (k, p) in prepared.iter().enumerate() {
+                if p.bounds()
+                    .intersect(ray.origin, inv, 0.0, f32::INFINITY)
+                    .is_none()
+                {
+                    continue;
+                }
+                let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
+                if intersect_f64(&patches[k], o, d, 0.0, f64::INFINITY, &cfg).is_some() {
+                    pairs.push((ray, k));
+                }
+            }
+        }
+    }
+    println!(
+        "{} (ray, patch) pairs hit by the f64 reference, collected in {:.1} s",
+        pairs.len(),
+        t0.elapsed().as_secs_f64()
+    );
+    let mut times = Vec::new();
+    let mut stats = KernelStats::default();
+    let mut max_splits = 0;
+    let mut hits = 0;
+    for run in 0..=RUNS {
+        let mut s = KernelStats::default();
+        let start = Instant::now();
+        hits = 0;
+        for (ray, k) in &pairs {
+            let before = s.splits;
+            if intersect(&prepared[*k], ray, &cfg, &mut s).is_some() {
+                hits += 1;
+            }
+            max_splits = max_splits.max(s.splits - before);
+        }
+        let dt = start.elapsed().as_secs_f64();
+        if run > 0 {
+            times.push(dt);
+        }
+        stats = s;
+    }
+    times.sort_by(f64::total_cmp);
+    let median = times[times.len() / 2];
+    let n = pairs.len() as f64;
+    println!("config: {cfg:?}");
+    println!(
+        "f32 hits: {hits} of {} pairs ({} misses)",
+        pairs.len(),
+        pairs.len() - hits
+    );
+    println!(
+        "median {:.3} s: {:.3} M ray-patch tests/s/core, {:.0} ns/test",
+        median,
+        n / median * 1e-6,
+        median / n * 1e9
+    );
+    println!(
+        "splits/test: mean {:.1}, max {}; box tests/test {:.1}; {:.1} ns/split",
+        stats.splits as f64 / n,
+        max_splits,
+        stats.box_tests as f64 / n,
+        median / stats.splits as f64 * 1e9
+    );
+}

@@ -1,0 +1,216 @@
+//! The bicubic non-rational fast path (Dammertz §2.3.3, §2.7.1: "extra optimized code for
+//! the most frequently used degrees"). The net is structure-of-arrays: per coordinate a
+//! 4×4 block of `f32` whose rows (fixed v, u = 0..3) are one SSE register each (glam's
+//! `Vec4` is `__m128` on x86_64 with SSE2). A split in v is de Casteljau across the four
+//! rows, 4 lanes at a time (Dammertz code 2.3.6 does the same on AoS points); a split in u
+//! transposes each block so that the columns become registers, splits, and transposes back.
+//! The box is a lane-wise min/max over the rows followed by a horizontal reduction.
+
+use glam::{Mat4, Vec4};
+
+use super::float::GBox;
+use super::heuristics::Corners;
+use super::param::Split;
+use super::search::NetStack;
+use crate::geom::{Aabb, BezierPatch};
+
+/// One coordinate of the net: `rows[j]` holds the points (0..4, j).
+type Block = [Vec4; 4];
+
+/// A bicubic control net in structure-of-arrays form.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Net {
+    pub xyz: [Block; 3],
+}
+
+/// De Casteljau at 1/2 across four registers: the same operations in the same order as
+/// `geom::bezier::split_curve_half`, so the shared middle row is bit-identical in both
+/// children.
+#[inline(always)]
+fn split4(r: Block) -> (Block, Block) {
+    let h = Vec4::splat(0.5);
+    let a01 = (r[0] + r[1]) * h;
+    let a12 = (r[1] + r[2]) * h;
+    let a23 = (r[2] + r[3]) * h;
+    let b0 = (a01 + a12) * h;
+    let b1 = (a12 + a23) * h;
+    let c = (b0 + b1) * h;
+    ([r[0], a01, b0, c], [c, b1, a23, r[3]])
+}
+
+#[inline(always)]
+fn transpose(b: Block) -> Block {
+    let m = Mat4::from_cols(b[0], b[1], b[2], b[3]).transpose();
+    [m.x_axis, m.y_axis, m.z_axis, m.w_axis]
+}
+
+#[inline(always)]
+fn block_range(b: &Block) -> (f32, f32) {
+    let lo = b[0].min(b[1]).min(b[2].min(b[3]));
+    let hi = b[0].max(b[1]).max(b[2].max(b[3]));
+    (lo.min_element(), hi.max_element())
+}
+
+impl Net {
+    /// The net of a plain bicubic patch, each coordinate rounded once to `f32`.
+    pub fn from_patch(patch: &BezierPatch) -> Net {
+        let mut xyz = [[Vec4::ZERO; 4]; 3];
+        for (k, p) in patch.euclidean_points().enumerate() {
+            let (i, j) = (k % 4, k / 4);
+            for (c, v) in p.as_vec3().to_array().into_iter().enumerate() {
+                xyz[c][j][i] = v;
+            }
+        }
+        Net { xyz }
+    }
+
+    #[inline(always)]
+    pub fn bounds(&self) -> Aabb {
+        let (x0, x1) = block_range(&self.xyz[0]);
+        let (y0, y1) = block_range(&self.xyz[1]);
+        let (z0, z1) = block_range(&self.xyz[2]);
+        Aabb::new(glam::Vec3::new(x0, y0, z0), glam::Vec3::new(x1, y1, z1))
+    }
+
+    /// Splits at 1/2: `self` becomes the lower half, the upper half is returned.
+    #[inline(always)]
+    pub fn split_in_place(&mut self, dir: Split) -> Net {
+        let mut upper = [[Vec4::ZERO; 4]; 3];
+        for (b, up) in self.xyz.iter_mut().zip(upper.iter_mut()) {
+            match dir {
+                Split::V => {
+                    let (lo, hi) = split4(*b);
+                    *b = lo;
+                    *up = hi;
+                }
+                Split::U => {
+                    let (lo, hi) = split4(transpose(*b));
+                    *b = transpose(lo);
+                    *up = transpose(hi);
+                }
+            }
+        }
+        Net { xyz: upper }
+    }
+
+    /// Point (i, j) of the net.
+    pub fn point(&self, i: usize, j: usize) -> [f32; 3] {
+        [self.xyz[0][j][i], self.xyz[1][j][i], self.xyz[2][j][i]]
+    }
+
+    #[inline(always)]
+    fn corners(&self) -> Corners<f32> {
+        let [x, y, z] = &self.xyz;
+        Corners {
+            p00: [x[0].x, y[0].x, z[0].x],
+            pn0: [x[0].w, y[0].w, z[0].w],
+            p0m: [x[3].x, y[3].x, z[3].x],
+        }
+    }
+}
+
+/// The current net by value, the pending upper child, and the pushed nets.
+pub struct BicubicStack<'a> {
+    pub cur: Net,
+    pub upper: Net,
+    pub pushed: &'a mut Vec<Net>,
+}
+
+impl NetStack<f32> for BicubicStack<'_> {
+    #[inline(always)]
+    fn corners(&self) -> Corners<f32> {
+        self.cur.corners()
+    }
+
+    #[inline(always)]
+    fn split(&mut self, dir: Split) -> [GBox<f32>; 2] {
+        self.upper = self.cur.split_in_place(dir);
+        [
+            GBox::from_aabb(self.cur.bounds()),
+            GBox::from_aabb(self.upper.bounds()),
+        ]
+    }
+
+    #[inline(always)]
+    fn push_far(&mut self, far_is_lower: bool) {
+        if far_is_lower {
+            self.pushed.push(self.cur);
+            self.cur = self.upper;
+        } else {
+            self.pushed.push(self.upper);
+        }
+    }
+
+    #[inline(always)]
+    fn keep(&mut self, lower: bool) {
+        if !lower {
+            self.cur = self.upper;
+        }
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) {
+        if let Some(n) = self.pushed.pop() {
+            self.cur = n;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    fn patch() -> BezierPatch {
+        let pts: Vec<DVec3> = (0..16)
+            .map(|k| {
+                let (i, j) = ((k % 4) as f64, (k / 4) as f64);
+                DVec3::new(
+                    i + 0.3 * (j * 1.7).sin(),
+                    j * 1.1 - 0.1 * i * i,
+                    (i * 0.9 - j).cos(),
+                )
+            })
+            .collect();
+        BezierPatch::from_points(3, 3, &pts).unwrap()
+    }
+
+    #[test]
+    fn in_place_split_matches_bezier_split_within_f32_rounding() {
+        let p = patch();
+        for (dir, (lo, hi)) in [(Split::U, p.split_u()), (Split::V, p.split_v())] {
+            let mut net = Net::from_patch(&p);
+            let upper = net.split_in_place(dir);
+            for (got, want) in [(net, lo), (upper, hi)] {
+                for j in 0..4 {
+                    for i in 0..4 {
+                        let g = got.point(i, j);
+                        let w = want.point(i, j);
+                        for c in 0..3 {
+                            // ½ ulp input rounding + ½ ulp per de Casteljau level (3).
+                            let tol = 2.0 * crate::geom::ulp::ulp_of(w[c].abs().max(4.0) as f32);
+                            assert!((g[c] as f64 - w[c]).abs() <= tol, "{g:?} vs {w:?}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn bounds_are_the_control_box() {
+        let p = patch();
+        let b = Net::from_patch(&p).bounds();
+        let want: Aabb = p.euclidean_points().map(|q| q.as_vec3()).collect();
+        assert_eq!(b, want);
+    }
+
+    #[test]
+    fn shared_edge_is_bit_identical() {
+        let mut net = Net::from_patch(&patch());
+        let upper = net.split_in_place(Split::U);
+        for j in 0..4 {
+            assert_eq!(net.point(3, j), upper.point(0, j));
+        }
+    }
+}

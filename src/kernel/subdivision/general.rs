@@ -1,0 +1,274 @@
+//! The general path: patches of any degree up to 15 and rational patches (Dammertz §2.7),
+//! in either precision. Control points are homogeneous `(w x, w y, w z, w)` so that a split
+//! is the same de Casteljau step as for integral patches (§2.7.2); boxes are taken of the
+//! projected points `x/w, y/w, z/w` (valid because the weights are positive) and rounded
+//! outward with `next_down`/`next_up`, so a box contains the projection of its net in exact
+//! arithmetic (the improvement Dammertz gets from directed rounding in code 2.7.3).
+//!
+//! Nets live in one reused scratch buffer of `2 · MAX_LEVEL + 2` slots: slot `k` holds
+//! the net of stack entry `k`, the current net sits on top, and a split writes its children
+//! into the top slot and the one above it.
+
+use super::float::{GBox, KernelFloat};
+use super::heuristics::Corners;
+use super::param::Split;
+use super::search::{NetStack, Node};
+
+/// Shape of a control net: points per row (u) and per column (v), and whether it needs
+/// the homogeneous division.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NetShape {
+    pub nu: usize,
+    pub nv: usize,
+    pub rational: bool,
+}
+
+impl NetShape {
+    pub fn point_count(&self) -> usize {
+        self.nu * self.nv
+    }
+}
+
+/// Reusable buffers of one search: no allocation per ray once they have grown.
+#[derive(Debug, Default)]
+pub struct Scratch<T> {
+    pub nets: Vec<[T; 4]>,
+    pub nodes: Vec<Node<T>>,
+}
+
+/// The box of a homogeneous net: exact for integral nets, rounded outward after the
+/// division for rational ones.
+pub fn net_box<T: KernelFloat>(net: &[[T; 4]], rational: bool) -> GBox<T> {
+    let mut b = GBox {
+        min: [T::INFINITY; 3],
+        max: [-T::INFINITY; 3],
+    };
+    for p in net {
+        for c in 0..3 {
+            let (lo, hi) = if rational {
+                let x = p[c] / p[3];
+                (x.next_down(), x.next_up())
+            } else {
+                (p[c], p[c])
+            };
+            b.min[c] = b.min[c].min(lo);
+            b.max[c] = b.max[c].max(hi);
+        }
+    }
+    b
+}
+
+/// Splits the curve of `n` points at `stride` apart in `net` at 1/2: the lower half stays
+/// in `net`, the upper half goes to `upper`. Same operations, in the same order, as
+/// `geom::bezier::split_curve_half`, so the `f64` path splits bit-identically.
+fn split_curve<T: KernelFloat>(
+    net: &mut [[T; 4]],
+    upper: &mut [[T; 4]],
+    start: usize,
+    stride: usize,
+    n: usize,
+) {
+    let at = |i: usize| start + i * stride;
+    for i in 0..n {
+        upper[at(i)] = net[at(i)];
+    }
+    for k in 0..n {
+        net[at(k)] = upper[at(0)];
+        for i in 0..n - 1 - k {
+            let (a, b) = (upper[at(i)], upper[at(i + 1)]);
+            upper[at(i)] = [0, 1, 2, 3].map(|c| (a[c] + b[c]) * T::HALF);
+        }
+    }
+}
+
+/// Splits a net in place at 1/2: lower child in `net`, upper child in `upper`.
+pub fn split_net<T: KernelFloat>(
+    net: &mut [[T; 4]],
+    upper: &mut [[T; 4]],
+    shape: NetShape,
+    dir: Split,
+) {
+    match dir {
+        Split::U => {
+            for j in 0..shape.nv {
+                split_curve(net, upper, j * shape.nu, 1, shape.nu);
+            }
+        }
+        Split::V => {
+            for i in 0..shape.nu {
+                split_curve(net, upper, i, shape.nu, shape.nv);
+            }
+        }
+    }
+}
+
+/// The nets of a general-path search in the slots of a scratch buffer.
+pub struct GeneralStack<'a, T> {
+    pub nets: &'a mut [[T; 4]],
+    pub shape: NetShape,
+    /// Slot of the current net.
+    pub top: usize,
+}
+
+impl<'a, T: KernelFloat> GeneralStack<'a, T> {
+    /// Prepares `scratch` for `net` (growing it only the first time) and puts `net` in
+    /// slot 0.
+    pub fn new(scratch: &'a mut Vec<[T; 4]>, net: &[[T; 4]], shape: NetShape) -> Self {
+        let n = shape.point_count();
+        let need = (2 * T::MAX_LEVEL as usize + 2) * n;
+        if scratch.len() < need {
+            scratch.resize(need, [T::ZERO; 4]);
+        }
+        scratch[..n].copy_from_slice(net);
+        GeneralStack {
+            nets: scratch,
+            shape,
+            top: 0,
+        }
+    }
+
+    fn slot(&self, k: usize) -> &[[T; 4]] {
+        let n = self.shape.point_count();
+        &self.nets[k * n..(k + 1) * n]
+    }
+
+    fn euclidean(&self, p: [T; 4]) -> [T; 3] {
+        if self.shape.rational {
+            [p[0] / p[3], p[1] / p[3], p[2] / p[3]]
+        } else {
+            [p[0], p[1], p[2]]
+        }
+    }
+}
+
+impl<T: KernelFloat> NetStack<T> for GeneralStack<'_, T> {
+    fn corners(&self) -> Corners<T> {
+        let net = self.slot(self.top);
+        let s = self.shape;
+        Corners {
+            p00: self.euclidean(net[0]),
+            pn0: self.euclidean(net[s.nu - 1]),
+            p0m: self.euclidean(net[(s.nv - 1) * s.nu]),
+        }
+    }
+
+    fn split(&mut self, dir: Split) -> [GBox<T>; 2] {
+        let n = self.shape.point_count();
+        let (lower, upper) = self.nets[self.top * n..(self.top + 2) * n].split_at_mut(n);
+        split_net(lower, upper, self.shape, dir);
+        [
+            net_box(lower, self.shape.rational),
+            net_box(upper, self.shape.rational),
+        ]
+    }
+
+    fn push_far(&mut self, far_is_lower: bool) {
+        // The pushed net must stay in the current slot and the continued one go above it.
+        if !far_is_lower {
+            let n = self.shape.point_count();
+            let (lower, upper) = self.nets[self.top * n..(self.top + 2) * n].split_at_mut(n);
+            lower.swap_with_slice(upper);
+        }
+        self.top += 1;
+    }
+
+    fn keep(&mut self, lower: bool) {
+        if !lower {
+            let n = self.shape.point_count();
+            let k = self.top * n;
+            self.nets.copy_within(k + n..k + 2 * n, k);
+        }
+    }
+
+    fn pop(&mut self) {
+        self.top -= 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::BezierPatch;
+    use glam::DVec3;
+
+    fn rational_patch() -> BezierPatch {
+        let (du, dv) = (3, 2);
+        let pts: Vec<DVec3> = (0..(du + 1) * (dv + 1))
+            .map(|k| {
+                let (i, j) = ((k % (du + 1)) as f64, (k / (du + 1)) as f64);
+                DVec3::new(i + 0.1 * j * j, j - 0.2 * i, (i * 0.7 + j * 1.3).sin())
+            })
+            .collect();
+        let w: Vec<f64> = (0..pts.len())
+            .map(|k| 0.3 + (k as f64 * 0.77).fract() * 3.0)
+            .collect();
+        BezierPatch::from_weighted(du, dv, &pts, &w).unwrap()
+    }
+
+    fn net_of(p: &BezierPatch) -> Vec<[f64; 4]> {
+        p.homogeneous_points()
+            .iter()
+            .map(|q| q.to_array())
+            .collect()
+    }
+
+    #[test]
+    fn f64_split_is_bit_identical_to_bezier_split() {
+        let p = rational_patch();
+        let shape = NetShape {
+            nu: 4,
+            nv: 3,
+            rational: true,
+        };
+        for (dir, (lo, hi)) in [(Split::U, p.split_u()), (Split::V, p.split_v())] {
+            let mut net = net_of(&p);
+            let mut upper = vec![[0.0; 4]; net.len()];
+            split_net(&mut net, &mut upper, shape, dir);
+            assert_eq!(net, net_of(&lo));
+            assert_eq!(upper, net_of(&hi));
+        }
+    }
+
+    #[test]
+    fn f32_split_matches_f64_within_rounding() {
+        let p = rational_patch();
+        let shape = NetShape {
+            nu: 4,
+            nv: 3,
+            rational: true,
+        };
+        for (dir, (lo, hi)) in [(Split::U, p.split_u()), (Split::V, p.split_v())] {
+            let mut net: Vec<[f32; 4]> = net_of(&p).iter().map(|q| q.map(|c| c as f32)).collect();
+            let mut upper = vec![[0.0f32; 4]; net.len()];
+            split_net(&mut net, &mut upper, shape, dir);
+            for (got, want) in net
+                .iter()
+                .chain(&upper)
+                .zip(net_of(&lo).iter().chain(&net_of(&hi)))
+            {
+                for c in 0..4 {
+                    // Input rounding (½ ulp) plus one rounding per de Casteljau level (3),
+                    // each at most ½ ulp of the largest magnitude involved.
+                    let tol = 4.0 * crate::geom::ulp::ulp_of(want[c].abs().max(8.0) as f32);
+                    assert!(
+                        (got[c] as f64 - want[c]).abs() <= tol,
+                        "{got:?} vs {want:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn outward_box_contains_the_exact_projections() {
+        let p = rational_patch();
+        let net: Vec<[f32; 4]> = net_of(&p).iter().map(|q| q.map(|c| c as f32)).collect();
+        let b = net_box(&net, true);
+        for q in &net {
+            for c in 0..3 {
+                let exact = q[c] as f64 / q[3] as f64;
+                assert!(b.min[c] as f64 <= exact && exact <= b.max[c] as f64);
+            }
+        }
+    }
+}

@@ -1,0 +1,115 @@
+//! The parameter interval of a sub-patch, tracked per stack entry so that a hit reports the
+//! centre of the final interval as (u, v) (Dammertz code 2.3.8, `paramStack`).
+//!
+//! Intervals are dyadic, so they are kept exactly in fixed point: `[u0, u0 + 2^-level_u)`
+//! with `u0` in units of 2^-63. The level also bounds the work. Termination: every split
+//! raises `level_u + level_v` by one and a direction is never split beyond
+//! `T::MAX_LEVEL` (32 for `f32`, 61 for `f64`); a cell at the limit in both directions is
+//! final. So a search is at most `2 · MAX_LEVEL` splits deep and its stack holds at most
+//! `2 · MAX_LEVEL` entries. No accuracy is lost by the limit: a Bézier patch of degree
+//! n ≤ 15 over a parameter interval of width h moves at most `n h D` (D the largest
+//! control-net edge), so at 2^-32 a box is below `2^-28 D`, under one `f32` ulp of any
+//! coordinate larger than `D / 16`; Dammertz's criterion normally stops the `f32` search
+//! after 20–30 levels per direction (measured on the teapot in `benches/kernel.rs`).
+
+/// Which parameter direction a split halves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Split {
+    U,
+    V,
+}
+
+/// Fixed-point position of 1.0: the cell coordinates are multiples of 2^-63.
+const ONE_FIXED: f64 = (1u64 << 63) as f64;
+
+/// A dyadic cell of the parameter square.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct ParamCell {
+    u0: u64,
+    v0: u64,
+    level_u: u8,
+    level_v: u8,
+}
+
+impl ParamCell {
+    /// The whole square [0,1]².
+    pub const ROOT: ParamCell = ParamCell {
+        u0: 0,
+        v0: 0,
+        level_u: 0,
+        level_v: 0,
+    };
+
+    pub fn levels(&self) -> (u8, u8) {
+        (self.level_u, self.level_v)
+    }
+
+    /// The two halves (lower parameter first).
+    #[inline(always)]
+    pub fn split(&self, dir: Split) -> (ParamCell, ParamCell) {
+        match dir {
+            Split::U => {
+                let level_u = self.level_u + 1;
+                let lo = ParamCell { level_u, ..*self };
+                let hi = ParamCell {
+                    u0: self.u0 + (1u64 << (63 - level_u)),
+                    ..lo
+                };
+                (lo, hi)
+            }
+            Split::V => {
+                let level_v = self.level_v + 1;
+                let lo = ParamCell { level_v, ..*self };
+                let hi = ParamCell {
+                    v0: self.v0 + (1u64 << (63 - level_v)),
+                    ..lo
+                };
+                (lo, hi)
+            }
+        }
+    }
+
+    /// Lower corner and width of the cell in u and v: `(u0, v0, wu, wv)`.
+    pub fn bounds(&self) -> (f64, f64, f64, f64) {
+        (
+            self.u0 as f64 / ONE_FIXED,
+            self.v0 as f64 / ONE_FIXED,
+            (-(self.level_u as f64)).exp2(),
+            (-(self.level_v as f64)).exp2(),
+        )
+    }
+
+    /// The centre of the cell, the (u, v) a hit reports (Dammertz code 2.3.8).
+    pub fn centre(&self) -> (f64, f64) {
+        let (u0, v0, wu, wv) = self.bounds();
+        (u0 + 0.5 * wu, v0 + 0.5 * wv)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn halves_tile_the_parent() {
+        let c = ParamCell::ROOT.split(Split::U).1.split(Split::V).0;
+        assert_eq!(c.bounds(), (0.5, 0.0, 0.5, 0.5));
+        let (a, b) = c.split(Split::U);
+        let (ab, bb) = (a.bounds(), b.bounds());
+        assert_eq!(ab.0 + ab.2, bb.0);
+        assert_eq!(ab.0, 0.5);
+        assert_eq!(bb.0 + bb.2, 1.0);
+        assert_eq!(a.centre(), (0.625, 0.25));
+    }
+
+    #[test]
+    fn deepest_cell_is_exact() {
+        let mut c = ParamCell::ROOT;
+        for _ in 0..61 {
+            c = c.split(Split::U).1;
+        }
+        let (u0, _, wu, _) = c.bounds();
+        assert_eq!(wu, (-61f64).exp2());
+        assert_eq!(u0, 1.0 - wu);
+    }
+}

@@ -1,0 +1,51 @@
+//! The per-patch data of the `f32` kernel, built once per patch: the bicubic fast path's
+//! structure-of-arrays net, or the general path's homogeneous net.
+
+use super::bicubic::Net;
+use super::general::{NetShape, net_box};
+use crate::geom::{Aabb, BezierPatch};
+
+/// Which path a patch takes (Dammertz §2.7.1: the choice is made once, before any ray).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum Prepared {
+    Bicubic(Net),
+    General { net: Vec<[f32; 4]>, shape: NetShape },
+}
+
+/// A patch ready for the `f32` subdivision kernel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PreparedPatch {
+    pub(crate) data: Prepared,
+    pub(crate) bounds: Aabb,
+}
+
+impl PreparedPatch {
+    pub fn new(patch: &BezierPatch) -> PreparedPatch {
+        if patch.is_plain_bicubic() {
+            let net = Net::from_patch(patch);
+            return PreparedPatch {
+                bounds: net.bounds(),
+                data: Prepared::Bicubic(net),
+            };
+        }
+        let shape = NetShape {
+            nu: patch.degree_u() + 1,
+            nv: patch.degree_v() + 1,
+            rational: patch.is_rational(),
+        };
+        let net: Vec<[f32; 4]> = patch
+            .homogeneous_points()
+            .iter()
+            .map(|p| p.as_vec4().to_array())
+            .collect();
+        PreparedPatch {
+            bounds: net_box(&net, shape.rational).to_aabb(),
+            data: Prepared::General { net, shape },
+        }
+    }
+
+    /// The box of the `f32` control net: contains every point the kernel can report.
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+}
