@@ -263,3 +263,23 @@ fn a_closed_pipe_is_not_an_error() {
     assert!(!stderr(&o).contains("panicked"), "{}", stderr(&o));
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
 }
+
+#[test]
+fn coordinates_beyond_f32_after_transforms_are_refused_naming_the_object() {
+    let text = std::fs::read_to_string(testdata("teapot.ron"))
+        .unwrap()
+        .replace(
+            "material: \"pink\")",
+            "material: \"pink\", transform: [Scale(1e38)])",
+        )
+        .replace(
+            "File(\"teapot.bpt\")",
+            &format!("File({:?})", testdata("teapot.bpt")),
+        );
+    let c = file("huge.ron", &text);
+    let err = info_fails(&c.path);
+    assert!(
+        err.contains("object \"teapot\": coordinates reach") && err.contains("f32 range"),
+        "{err}"
+    );
+}

@@ -67,7 +67,37 @@ pub fn load_geometry(path: &Path) -> Result<Geometry, LoadError> {
 }
 
 /// Reads a scene: a RON scene file, or bare geometry framed by a default camera and light.
+/// Scenes whose coordinates do not fit `f32` after transforms are refused.
 pub fn load_scene(path: &Path) -> Result<Scene, LoadError> {
+    let scene = read_any_scene(path)?;
+    check_f32_range(path, &scene)?;
+    Ok(scene)
+}
+
+/// The renderer rounds geometry to `f32` once; a coordinate beyond its range would become
+/// infinite there, so it is refused with the object's name.
+fn check_f32_range(path: &Path, scene: &Scene) -> Result<(), LoadError> {
+    for o in &scene.objects {
+        let b = o.bounds();
+        if b.is_empty() {
+            continue;
+        }
+        let largest = b.min.abs().max(b.max.abs()).max_element();
+        if !((largest as f32).is_finite()) {
+            return Err(LoadError::invalid(
+                path,
+                format!(
+                    "object \"{}\": coordinates reach {largest:e} after transforms, beyond the f32 range (±{:e}) the renderer works in",
+                    o.name,
+                    f32::MAX
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn read_any_scene(path: &Path) -> Result<Scene, LoadError> {
     match InputKind::of(path).ok_or_else(|| unknown_kind(path))? {
         InputKind::Ron => ron_format::read_scene(path),
         _ => {
