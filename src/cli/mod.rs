@@ -6,6 +6,7 @@
 pub mod args;
 mod bvh;
 mod convert;
+mod diff;
 mod import;
 mod info;
 pub mod man;
@@ -54,6 +55,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Bvh(a) => bvh::run(a),
         Command::Render(a) => render::run(a),
         Command::Trace(a) => trace::run(a),
+        Command::Diff(a) => diff::run(a),
         Command::Scene(args::SceneCommand::Teapots(a)) => scene_gen::teapots(a),
     }
 }
