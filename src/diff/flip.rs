@@ -25,10 +25,15 @@ pub fn flip(a: &Image, b: &Image) -> (Vec<f32>, FlipStats) {
         |img: &Image| nv_flip::FlipImageRgb8::with_data(img.width, img.height, &img.to_srgb8_rgb());
     let map = nv_flip::flip(rgb8(a), rgb8(b), nv_flip::DEFAULT_PIXELS_PER_DEGREE);
     let mut pool = nv_flip::FlipPool::from_image(&map);
+    let values = map.to_vec();
+    // Mean and max straight from the map, in f64: the pool's max starts at
+    // f32::MIN_POSITIVE, so identical images would not report 0. The weighted median
+    // needs the pool's histogram.
+    let n = values.len() as f64;
     let stats = FlipStats {
-        mean: f64::from(pool.mean()),
+        mean: values.iter().map(|&v| f64::from(v)).sum::<f64>() / n,
         weighted_median: f64::from(pool.get_percentile(0.5, true)),
-        max: f64::from(pool.max_value()),
+        max: values.iter().fold(0.0f64, |m, &v| m.max(f64::from(v))),
     };
-    (map.to_vec(), stats)
+    (values, stats)
 }
