@@ -100,6 +100,20 @@ fn serialize_psnr<S: Serializer>(psnr: &f64, s: S) -> Result<S::Ok, S::Error> {
 }
 
 /// Compares `b` (test) against `a` (reference).
+///
+/// # Examples
+///
+/// ```
+/// use glam::Vec4;
+/// use patchtrace::diff::{DiffOptions, Image, diff_images};
+///
+/// let a = Image::linear(8, 8, vec![Vec4::new(0.2, 0.2, 0.2, 1.0); 64], true);
+/// let b = Image::linear(8, 8, vec![Vec4::new(0.3, 0.3, 0.3, 1.0); 64], true);
+/// let r = diff_images(&a, &b, DiffOptions::default()).unwrap();
+/// assert!((r.rmse - 0.1).abs() < 1e-6);
+/// assert!((r.psnr - 20.0).abs() < 1e-4);
+/// assert_eq!(r.coverage_mismatch, Some(0));
+/// ```
 pub fn diff_images(a: &Image, b: &Image, opts: DiffOptions) -> Result<DiffReport, DiffError> {
     if (a.width, a.height) != (b.width, b.height) {
         return Err(DiffError::SizeMismatch {
