@@ -11,6 +11,7 @@
 
 pub mod accel;
 pub mod cli;
+pub mod diff;
 pub mod geom;
 pub mod kernel;
 pub mod render;

@@ -29,6 +29,8 @@ pub enum Command {
     Trace(TraceArgs),
     /// Tessellate free-form surfaces into a triangle mesh (OBJ, glTF or GLB).
     Tessellate(TessellateArgs),
+    /// Compare two images (PNG or EXR): RMSE, PSNR, MAE, max error, FLIP, coverage.
+    Diff(DiffArgs),
     /// Generate test scenes.
     #[command(subcommand)]
     Scene(SceneCommand),
@@ -228,4 +230,38 @@ fn parse_grid(s: &str) -> Result<(u32, u32), String> {
             .map_err(|_| format!("expected a whole number, found `{x}`"))
     };
     Ok((p(u)?, p(v)?))
+}
+/// What a heat map shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum HeatmapChoice {
+    /// The FLIP error map (perceptual, 0 to 1).
+    Flip,
+    /// The largest channel's absolute error, 0 to 1, in the space of the metrics.
+    Abs,
+}
+
+#[derive(Debug, Args)]
+pub struct DiffArgs {
+    /// Reference image (.png or .exr).
+    pub a: PathBuf,
+    /// Test image (.png or .exr), the same size as A.
+    pub b: PathBuf,
+    /// A pixel counts toward `above` when its largest channel error exceeds this (values in
+    /// [0, 1]: sRGB-encoded when both images are PNG, linear clamped to [0, 1] otherwise).
+    #[arg(long, default_value_t = crate::diff::DEFAULT_THRESHOLD)]
+    pub threshold: f64,
+    /// Write the per-pixel error, colour-mapped (magma) above a 0-to-1 legend, as PNG.
+    #[arg(long, value_name = "OUT.png")]
+    pub heatmap: Option<PathBuf>,
+    /// Error shown by the heat map.
+    #[arg(long, value_enum, default_value_t = HeatmapChoice::Flip)]
+    pub heatmap_metric: HeatmapChoice,
+    /// Exit with status 1 when METRIC is greater than VALUE (repeatable). Metrics: rmse,
+    /// mae, max, above (share of pixels, 0 to 1), coverage (pixels), flip-mean,
+    /// flip-median, flip-max.
+    #[arg(long, value_name = "METRIC=VALUE")]
+    pub fail_above: Vec<crate::diff::Limit>,
+    /// Print JSON instead of a table (PSNR of identical images is the string "inf").
+    #[arg(long)]
+    pub json: bool,
 }

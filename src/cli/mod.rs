@@ -6,6 +6,7 @@
 pub mod args;
 mod bvh;
 mod convert;
+mod diff;
 mod import;
 mod info;
 pub mod man;
@@ -56,6 +57,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Render(a) => render::run(a),
         Command::Trace(a) => trace::run(a),
         Command::Tessellate(a) => tessellate::run(a),
+        Command::Diff(a) => diff::run(a),
         Command::Scene(args::SceneCommand::Teapots(a)) => scene_gen::teapots(a),
     }
 }
