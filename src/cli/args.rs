@@ -31,6 +31,9 @@ pub enum Command {
     Tessellate(TessellateArgs),
     /// Compare two images (PNG or EXR): RMSE, PSNR, MAE, max error, FLIP, coverage.
     Diff(DiffArgs),
+    /// Render the exact surfaces and triangle tessellations of a scene, diff them, and
+    /// tabulate accuracy against cost.
+    Compare(CompareArgs),
     /// Generate test scenes.
     #[command(subcommand)]
     Scene(SceneCommand),
@@ -264,4 +267,28 @@ pub struct DiffArgs {
     /// Print JSON instead of a table (PSNR of identical images is the string "inf").
     #[arg(long)]
     pub json: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// Scene (.ron) or bare geometry.
+    pub scene: PathBuf,
+    /// Triangles per patch of each tessellation to compare (even counts 2·u·v).
+    #[arg(long, value_delimiter = ',', default_values_t = [512u32, 4608, 131072])]
+    pub triangles: Vec<u32>,
+    /// Directory for the images, heat maps and the table (created if missing).
+    #[arg(long, default_value = "compare-out")]
+    pub out_dir: PathBuf,
+    /// Override the camera's image width.
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Override the camera's image height.
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// No progress bars.
+    #[arg(short, long)]
+    pub quiet: bool,
 }

@@ -5,6 +5,7 @@
 
 pub mod args;
 mod bvh;
+mod compare;
 mod convert;
 mod diff;
 mod import;
@@ -58,6 +59,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Trace(a) => trace::run(a),
         Command::Tessellate(a) => tessellate::run(a),
         Command::Diff(a) => diff::run(a),
+        Command::Compare(a) => compare::run(a),
         Command::Scene(args::SceneCommand::Teapots(a)) => scene_gen::teapots(a),
     }
 }

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use glam::Vec4;
 
-use crate::render::film::{Film, ImageFormat, linear_to_srgb};
+use crate::render::film::{Film, ImageFormat, linear_to_srgb8};
 use crate::scene::LoadError;
 
 /// How an image's values were stored, which decides the space its metrics are taken in.
@@ -55,12 +55,12 @@ impl Image {
         self.pixels
             .iter()
             .flat_map(|p| [p.x, p.y, p.z])
-            .map(|c| (linear_to_srgb(c) * 255.0 + 0.5) as u8)
+            .map(linear_to_srgb8)
             .collect()
     }
 }
 
-/// The inverse of [`linear_to_srgb`] (IEC 61966-2-1).
+/// The inverse of [`crate::render::film::linear_to_srgb`] (IEC 61966-2-1).
 pub fn srgb_to_linear(x: f32) -> f32 {
     if x <= 0.040_45 {
         x / 12.92
@@ -163,7 +163,7 @@ mod tests {
     #[test]
     fn srgb_round_trip_recovers_every_byte() {
         for b in 0..=255u8 {
-            let back = (linear_to_srgb(srgb_to_linear(f32::from(b) / 255.0)) * 255.0 + 0.5) as u8;
+            let back = linear_to_srgb8(srgb_to_linear(f32::from(b) / 255.0));
             assert_eq!(back, b);
         }
     }

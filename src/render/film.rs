@@ -33,6 +33,11 @@ impl ImageFormat {
     }
 }
 
+/// One linear channel as an 8-bit sRGB code, rounded to nearest.
+pub fn linear_to_srgb8(x: f32) -> u8 {
+    (linear_to_srgb(x) * 255.0 + 0.5) as u8
+}
+
 /// The sRGB transfer function (IEC 61966-2-1).
 pub fn linear_to_srgb(x: f32) -> f32 {
     let x = x.clamp(0.0, 1.0);
@@ -48,9 +53,7 @@ impl Film {
     pub fn to_srgb8(&self) -> Vec<u8> {
         let mut out = Vec::with_capacity(self.pixels.len() * 4);
         for p in &self.pixels {
-            for c in [p.x, p.y, p.z] {
-                out.push((linear_to_srgb(c) * 255.0 + 0.5) as u8);
-            }
+            out.extend([p.x, p.y, p.z].map(linear_to_srgb8));
             out.push((p.w.clamp(0.0, 1.0) * 255.0 + 0.5) as u8);
         }
         out
