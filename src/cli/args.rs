@@ -34,6 +34,9 @@ pub enum Command {
     /// Render the exact surfaces and triangle tessellations of a scene, diff them, and
     /// tabulate accuracy against cost.
     Compare(CompareArgs),
+    /// Benchmarks: accuracy against time.
+    #[command(subcommand)]
+    Bench(BenchCommand),
     /// Generate test scenes.
     #[command(subcommand)]
     Scene(SceneCommand),
@@ -289,6 +292,38 @@ pub struct CompareArgs {
     #[arg(long)]
     pub threads: Option<usize>,
     /// No progress bars.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum BenchCommand {
+    /// Every method against the f64 reference: hit and normal error, holes, false hits,
+    /// time per ray and memory, as a table, CSV and a log-log plot with the Pareto front.
+    Accuracy(AccuracyArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct AccuracyArgs {
+    /// Scene (.ron) or bare geometry.
+    pub scene: PathBuf,
+    /// Trace these rays (`ox oy oz dx dy dz [tmin [tmax]]` per line) instead of the
+    /// camera's primary rays.
+    #[arg(long)]
+    pub rays: Option<PathBuf>,
+    /// Trace an N×N image of camera rays instead of the camera's own size.
+    #[arg(long, value_name = "N")]
+    pub size: Option<u32>,
+    /// Triangles per patch of the tessellated methods.
+    #[arg(long, value_delimiter = ',', default_values_t = [512u32, 4608, 131072])]
+    pub triangles: Vec<u32>,
+    /// Directory for accuracy.md, accuracy.csv and accuracy.svg.
+    #[arg(long, default_value = "bench-out")]
+    pub out_dir: PathBuf,
+    /// Print the results as JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// No progress messages.
     #[arg(short, long)]
     pub quiet: bool,
 }

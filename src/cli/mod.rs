@@ -4,6 +4,7 @@
 //! or invalid files), 1 for other failures.
 
 pub mod args;
+mod bench_accuracy;
 mod bvh;
 mod compare;
 mod convert;
@@ -60,6 +61,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Tessellate(a) => tessellate::run(a),
         Command::Diff(a) => diff::run(a),
         Command::Compare(a) => compare::run(a),
+        Command::Bench(args::BenchCommand::Accuracy(a)) => bench_accuracy::run(a),
         Command::Scene(args::SceneCommand::Teapots(a)) => scene_gen::teapots(a),
     }
 }

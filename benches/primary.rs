@@ -1,0 +1,91 @@
+//! Primary-ray throughput through the whole scene query (BVH + kernel), single threaded:
+//! the bare teapot (testdata/teapot.bpt, 32 bicubic patches) traced directly, and the same
+//! teapot tessellated at 4608 triangles per patch (147,456 triangles, Dammertz Table 2.1's
+//! middle row) traced with the watertight triangle kernel. Camera of DESIGN.md's sample
+//! scene, 512², one ray per pixel; median of several runs after a warm-up.
+//!
+//! `cargo bench --bench primary`
+
+use std::path::Path;
+use std::time::Instant;
+
+use glam::DVec3;
+use patchtrace::accel::scene::{Precision, QueryStats, SceneGeometry};
+use patchtrace::geom::Ray;
+use patchtrace::kernel::subdivision::SubdivisionConfig;
+use patchtrace::render::camera::CameraRays;
+use patchtrace::scene::{Camera, Geometry, Object, Scene, Surface, bpt::read_bpt};
+use patchtrace::tessellate::{TessellationMode, tessellate_scene};
+
+const RUNS: usize = 5;
+const SIZE: u32 = 512;
+
+fn camera() -> Camera {
+    Camera {
+        eye: DVec3::new(0.0, -8.0, 4.5),
+        look_at: DVec3::new(0.0, 0.0, 1.2),
+        up: DVec3::Z,
+        fov_y: 40.0,
+        width: SIZE,
+        height: SIZE,
+    }
+}
+
+/// Median seconds to trace `rays` through `geometry`, and the number of hits.
+fn time(geometry: &SceneGeometry, rays: &[Ray]) -> (f64, usize) {
+    let precision = Precision::F32(SubdivisionConfig::default());
+    let mut samples = Vec::new();
+    let mut hits = 0;
+    for run in 0..=RUNS {
+        let start = Instant::now();
+        let mut stats = QueryStats::default();
+        hits = rays
+            .iter()
+            .filter(|r| geometry.intersect(r, &precision, &mut stats).is_some())
+            .count();
+        if run > 0 {
+            samples.push(start.elapsed().as_secs_f64());
+        }
+    }
+    samples.sort_by(f64::total_cmp);
+    (samples[samples.len() / 2], hits)
+}
+
+fn main() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("testdata/teapot.bpt");
+    let patches = read_bpt(&path).expect("testdata/teapot.bpt");
+    let mut scene = Scene::framing(vec![Object {
+        name: "teapot".into(),
+        material: 0,
+        geometry: Geometry::Surfaces(patches.into_iter().map(Surface::bezier).collect()),
+    }]);
+    scene.camera = camera();
+    let cam = CameraRays::new(&scene.camera);
+    let rays: Vec<Ray> = (0..SIZE)
+        .flat_map(|y| (0..SIZE).map(move |x| (x, y)))
+        .map(|(x, y)| cam.ray(x, y))
+        .collect();
+
+    let direct = SceneGeometry::build(&scene);
+    let (seconds, hits) = time(&direct, &rays);
+    println!(
+        "patches   {:>7} prims: {:.3} s, {:.2} M rays/s/core, {} hits, {:.3} M patch hits/s/core",
+        direct.patch_count(),
+        seconds,
+        rays.len() as f64 / seconds / 1e6,
+        hits,
+        hits as f64 / seconds / 1e6
+    );
+
+    let (meshes, report) =
+        tessellate_scene(&scene, TessellationMode::TrianglesPerPatch(4608)).expect("tessellate");
+    let triangles = SceneGeometry::build(&meshes);
+    let (seconds, hits) = time(&triangles, &rays);
+    println!(
+        "triangles {:>7} prims: {:.3} s, {:.2} M rays/s/core, {} hits",
+        report.triangles,
+        seconds,
+        rays.len() as f64 / seconds / 1e6,
+        hits
+    );
+}

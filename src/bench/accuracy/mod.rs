@@ -1,0 +1,279 @@
+//! `bench accuracy`: what accuracy costs in time. Every method traces the same rays (the
+//! camera's primary rays, or a ray file) and is compared with the `f64` reference path
+//! (the same subdivision algorithm in `f64`): hit-point and normal error (L1, as Dammertz
+//! Tables 2.1–2.4, and relative to the hit's coordinate magnitude), holes and false hits,
+//! time per ray (median of several single-threaded runs after a warm-up) and memory.
+//! The plot of mean error against time per ray, log-log, with the Pareto front, is in
+//! [`plot`].
+
+pub mod plot;
+
+use std::time::Instant;
+
+use glam::DVec3;
+use serde::Serialize;
+
+use crate::accel::scene::{Precision, QueryStats, SceneGeometry, SceneHit};
+use crate::geom::Ray;
+use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig};
+use crate::scene::Scene;
+use crate::scene::rays::RayQuery;
+use crate::tessellate::{TessellationMode, TessellationReport, tessellate_scene};
+
+/// Timed runs per method after one warm-up run; the median is reported.
+pub const TIMED_RUNS: usize = 3;
+
+/// A way of intersecting rays with the scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Method {
+    /// The float-precision subdivision kernel in `f32` (Dammertz §2.3).
+    Float(SplitHeuristic),
+    /// The scene tessellated with this many triangles per patch (Dammertz Tables 2.1–2.4).
+    Tessellated(u32),
+}
+
+impl Method {
+    pub fn name(&self) -> String {
+        match self {
+            Method::Float(SplitHeuristic::Length) => "float, length heuristic".into(),
+            Method::Float(SplitHeuristic::CrossProduct) => "float, cross-product heuristic".into(),
+            Method::Tessellated(n) => format!("{n} triangles/patch"),
+        }
+    }
+
+    /// The methods of a default run: both heuristics, and the tessellations of Dammertz's
+    /// tables.
+    pub fn defaults() -> Vec<Method> {
+        vec![
+            Method::Float(SplitHeuristic::Length),
+            Method::Float(SplitHeuristic::CrossProduct),
+            Method::Tessellated(512),
+            Method::Tessellated(4608),
+            Method::Tessellated(131072),
+        ]
+    }
+}
+
+/// Minimum, maximum, mean and variance of an error over the rays where both hit.
+#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
+pub struct ErrorStats {
+    pub min: f64,
+    pub max: f64,
+    pub mean: f64,
+    pub variance: f64,
+}
+
+impl ErrorStats {
+    fn of(values: &[f64]) -> ErrorStats {
+        if values.is_empty() {
+            return ErrorStats::default();
+        }
+        let n = values.len() as f64;
+        let mean = values.iter().sum::<f64>() / n;
+        ErrorStats {
+            min: values.iter().copied().fold(f64::INFINITY, f64::min),
+            max: values.iter().copied().fold(0.0, f64::max),
+            mean,
+            variance: values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n,
+        }
+    }
+}
+
+/// One row of the report.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct MethodResult {
+    pub method: String,
+    /// Hit-point error, L1 distance to the reference hit point.
+    pub hit_error: ErrorStats,
+    /// Hit-point error divided by the largest coordinate magnitude of the reference hit.
+    pub hit_error_relative: ErrorStats,
+    /// Normal error, L1 distance between unit normals (orientation ignored).
+    pub normal_error: ErrorStats,
+    /// Rays the reference hits and the method misses.
+    pub holes: u64,
+    /// Rays the method hits and the reference misses.
+    pub false_hits: u64,
+    pub rays: u64,
+    pub nanoseconds_per_ray: f64,
+    /// Geometry memory: patch control points in f32, or the triangle mesh.
+    pub memory_bytes: u64,
+}
+
+/// The reference answer for one ray.
+struct Reference {
+    hit: Option<(DVec3, DVec3)>,
+}
+
+/// Hit point and normal of a hit, for a ray given in `f64`.
+fn point_and_normal(h: &SceneHit, origin: DVec3, dir: DVec3, use_shading: bool) -> (DVec3, DVec3) {
+    (
+        origin + dir * h.t,
+        if use_shading {
+            h.shading_normal
+        } else {
+            h.normal
+        },
+    )
+}
+
+/// Runs every method over `rays` and compares with the `f64` reference.
+pub fn run(
+    scene: &Scene,
+    rays: &[RayQuery],
+    methods: &[Method],
+    mut progress: impl FnMut(&str),
+) -> anyhow::Result<Vec<MethodResult>> {
+    let exact = SceneGeometry::build(scene);
+    progress("f64 reference");
+    let reference_cfg = SubdivisionConfig::default();
+    let reference: Vec<Reference> = rays
+        .iter()
+        .map(|q| {
+            let mut stats = QueryStats::default();
+            let hit = exact
+                .intersect_f64(q.origin, q.dir, q.tmin, q.tmax, &reference_cfg, &mut stats)
+                .map(|h| point_and_normal(&h, q.origin, q.dir, false));
+            Reference { hit }
+        })
+        .collect();
+    let f32_rays: Vec<Ray> = rays
+        .iter()
+        .map(|q| Ray {
+            origin: q.origin.as_vec3(),
+            dir: q.dir.as_vec3(),
+            tmin: q.tmin as f32,
+            tmax: q.tmax as f32,
+        })
+        .collect();
+
+    let mut results = Vec::new();
+    for method in methods {
+        progress(&method.name());
+        let (geometry, memory, precision) = match *method {
+            Method::Float(heuristic) => {
+                let cfg = SubdivisionConfig {
+                    heuristic,
+                    ..SubdivisionConfig::default()
+                };
+                (None, patch_memory(scene), Precision::F32(cfg))
+            }
+            Method::Tessellated(n) => {
+                let (meshes, report): (Scene, TessellationReport) =
+                    tessellate_scene(scene, TessellationMode::TrianglesPerPatch(n))?;
+                (
+                    Some(SceneGeometry::build(&meshes)),
+                    report.bytes,
+                    Precision::F32(SubdivisionConfig::default()),
+                )
+            }
+        };
+        let geometry = geometry.as_ref().unwrap_or(&exact);
+        let shading = matches!(method, Method::Tessellated(_));
+        let mut answers = Vec::new();
+        let mut times = Vec::new();
+        for run in 0..=TIMED_RUNS {
+            let start = Instant::now();
+            let mut stats = QueryStats::default();
+            answers = f32_rays
+                .iter()
+                .map(|r| geometry.intersect(r, &precision, &mut stats))
+                .collect();
+            if run > 0 {
+                times.push(start.elapsed().as_secs_f64());
+            }
+        }
+        times.sort_by(f64::total_cmp);
+        let seconds = times[times.len() / 2];
+
+        let (mut hit_err, mut rel_err, mut normal_err) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut holes, mut false_hits) = (0, 0);
+        for ((answer, reference), r) in answers.iter().zip(&reference).zip(&f32_rays) {
+            match (answer, &reference.hit) {
+                (Some(h), Some((p_ref, n_ref))) => {
+                    let (p, n) =
+                        point_and_normal(h, r.origin.as_dvec3(), r.dir.as_dvec3(), shading);
+                    let e = (p - p_ref).abs().element_sum();
+                    hit_err.push(e);
+                    rel_err.push(e / p_ref.abs().max_element().max(f64::MIN_POSITIVE));
+                    normal_err.push(
+                        (n - n_ref)
+                            .abs()
+                            .element_sum()
+                            .min((n + n_ref).abs().element_sum()),
+                    );
+                }
+                (None, Some(_)) => holes += 1,
+                (Some(_), None) => false_hits += 1,
+                (None, None) => {}
+            }
+        }
+        results.push(MethodResult {
+            method: method.name(),
+            hit_error: ErrorStats::of(&hit_err),
+            hit_error_relative: ErrorStats::of(&rel_err),
+            normal_error: ErrorStats::of(&normal_err),
+            holes,
+            false_hits,
+            rays: rays.len() as u64,
+            nanoseconds_per_ray: seconds * 1e9 / rays.len().max(1) as f64,
+            memory_bytes: memory,
+        });
+    }
+    Ok(results)
+}
+
+/// Bytes of the scene's patches as the kernel stores them: x, y, z (and w) in f32.
+pub fn patch_memory(scene: &Scene) -> u64 {
+    scene
+        .objects
+        .iter()
+        .flat_map(|o| o.bezier_patches())
+        .map(|p| p.point_count() as u64 * if p.is_rational() { 16 } else { 12 })
+        .sum()
+}
+
+/// The report as a Markdown table.
+pub fn markdown(results: &[MethodResult]) -> String {
+    let mut s = String::from(
+        "| method | mean hit error | max hit error | mean rel. error | mean normal error | max normal error | holes | false hits | ns/ray | memory (bytes) |\n|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in results {
+        s.push_str(&format!(
+            "| {} | {:.3e} | {:.3e} | {:.3e} | {:.3e} | {:.3e} | {} | {} | {:.0} | {} |\n",
+            r.method,
+            r.hit_error.mean,
+            r.hit_error.max,
+            r.hit_error_relative.mean,
+            r.normal_error.mean,
+            r.normal_error.max,
+            r.holes,
+            r.false_hits,
+            r.nanoseconds_per_ray,
+            r.memory_bytes
+        ));
+    }
+    s
+}
+
+/// The report as CSV, every statistic in its own column.
+pub fn csv(results: &[MethodResult]) -> String {
+    let mut s = String::from(
+        "method,hit_min,hit_max,hit_mean,hit_variance,rel_min,rel_max,rel_mean,rel_variance,normal_min,normal_max,normal_mean,normal_variance,holes,false_hits,rays,ns_per_ray,memory_bytes\n",
+    );
+    for r in results {
+        let e = |x: &ErrorStats| format!("{:e},{:e},{:e},{:e}", x.min, x.max, x.mean, x.variance);
+        s.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{}\n",
+            r.method,
+            e(&r.hit_error),
+            e(&r.hit_error_relative),
+            e(&r.normal_error),
+            r.holes,
+            r.false_hits,
+            r.rays,
+            r.nanoseconds_per_ray,
+            r.memory_bytes
+        ));
+    }
+    s
+}

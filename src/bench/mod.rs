@@ -1,0 +1,3 @@
+//! Benchmarks that are commands: accuracy against time (`bench accuracy`).
+
+pub mod accuracy;

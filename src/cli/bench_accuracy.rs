@@ -1,0 +1,80 @@
+//! `patchtrace bench accuracy SCENE`: what accuracy costs in time.
+
+use std::io::Write;
+use std::process::ExitCode;
+
+use anyhow::Context;
+
+use crate::bench::accuracy::{self, Method, plot};
+use crate::cli::args::AccuracyArgs;
+use crate::kernel::subdivision::SplitHeuristic;
+use crate::render::camera::CameraRays;
+use crate::scene::error::read_text;
+use crate::scene::load_scene;
+use crate::scene::rays::{RayQuery, parse_rays};
+use crate::scene::write::write_atomic;
+
+pub fn run(args: AccuracyArgs) -> anyhow::Result<ExitCode> {
+    let mut scene = load_scene(&args.scene)?;
+    if let Some(n) = args.size {
+        anyhow::ensure!(n > 0, "--size must be at least 1");
+        scene.camera.width = n;
+        scene.camera.height = n;
+    }
+    let rays = match &args.rays {
+        Some(path) => parse_rays(path, &read_text(path)?)?,
+        None => {
+            let cam = CameraRays::new(&scene.camera);
+            let (w, h) = (scene.camera.width, scene.camera.height);
+            (0..h)
+                .flat_map(|y| (0..w).map(move |x| (x, y)))
+                .map(|(x, y)| {
+                    let (origin, dir) = cam.ray_f64(x, y, 0.5, 0.5);
+                    RayQuery {
+                        origin,
+                        dir,
+                        tmin: 0.0,
+                        tmax: f64::INFINITY,
+                    }
+                })
+                .collect()
+        }
+    };
+    let mut methods = vec![
+        Method::Float(SplitHeuristic::Length),
+        Method::Float(SplitHeuristic::CrossProduct),
+    ];
+    methods.extend(args.triangles.iter().map(|&n| Method::Tessellated(n)));
+    let quiet = args.quiet;
+    let results = accuracy::run(&scene, &rays, &methods, |what| {
+        if !quiet {
+            eprintln!("tracing {} rays: {what}", rays.len());
+        }
+    })?;
+
+    std::fs::create_dir_all(&args.out_dir)
+        .with_context(|| format!("creating {}", args.out_dir.display()))?;
+    let table = accuracy::markdown(&results);
+    let title = format!("{}: error against time per ray", args.scene.display());
+    let svg = plot::svg(&results, &title).map_err(|e| anyhow::anyhow!("drawing the plot: {e}"))?;
+    for (name, text) in [
+        ("accuracy.md", &table),
+        ("accuracy.csv", &accuracy::csv(&results)),
+        ("accuracy.svg", &svg),
+    ] {
+        write_atomic(&args.out_dir.join(name), |w| w.write_all(text.as_bytes()))?;
+    }
+    let mut out = std::io::stdout().lock();
+    if args.json {
+        writeln!(out, "{}", serde_json::to_string_pretty(&results)?)?;
+    } else {
+        writeln!(out, "{table}")?;
+    }
+    if !quiet {
+        eprintln!(
+            "wrote accuracy.md, accuracy.csv and accuracy.svg to {}",
+            args.out_dir.display()
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
