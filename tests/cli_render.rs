@@ -199,3 +199,42 @@ fn exr_output_is_linear_rgba_with_coverage_alpha() {
     assert_eq!(px[0][10].3, 0.0);
     assert_eq!(px[12][10].3, 1.0);
 }
+
+#[test]
+fn effort_aov_counts_every_split_of_the_render() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("e.png");
+    let scene = testdata("teapot.ron");
+    let o = run(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+        "--width",
+        "24",
+        "--height",
+        "24",
+        "--aov",
+        "effort",
+        "--stats",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let s: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let total_splits = s["rays"]["splits_per_ray"]["mean"].as_f64().unwrap()
+        * s["rays"]["total"].as_f64().unwrap();
+    use exr::prelude::*;
+    let img = read_first_flat_layer_from_file(dir.path().join("e-effort.exr")).unwrap();
+    let channel = &img.layer_data.channel_data.list[0];
+    assert_eq!(channel.name.to_string(), "effort");
+    let values: Vec<f32> = channel.sample_data.values_as_f32().collect();
+    assert_eq!(values.len(), 24 * 24);
+    let sum: f64 = values.iter().map(|&v| v as f64).sum();
+    assert!(
+        (sum - total_splits).abs() <= 1e-6 * total_splits,
+        "{sum} vs {total_splits}"
+    );
+    // The top-left pixel sees only background: no patch, no split.
+    assert_eq!(values[0], 0.0);
+    assert!(dir.path().join("e-effort.png").exists());
+}

@@ -174,9 +174,20 @@ pub struct RenderArgs {
     /// Print statistics as JSON on stdout.
     #[arg(long)]
     pub stats: bool,
+    /// Extra outputs beside the image: `effort` writes <name>-effort.exr (splits per pixel)
+    /// and a colour-mapped <name>-effort.png (Dammertz Fig. 2.9).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub aov: Vec<Aov>,
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// Arbitrary output variables of `render`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Aov {
+    /// de Casteljau splits of all rays started from each pixel.
+    Effort,
 }
 
 #[derive(Debug, Args)]

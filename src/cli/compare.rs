@@ -64,7 +64,7 @@ fn render(scene: &Scene, quiet: bool, label: &str, pool: &rayon::ThreadPool) -> 
     };
     let bar = progress_bar(quiet, label);
     let start = Instant::now();
-    let (film, _) = pool.install(|| render_image(&integrator, &bar));
+    let film = pool.install(|| render_image(&integrator, &bar)).film;
     (film, build, start.elapsed().as_secs_f64())
 }
 

@@ -38,11 +38,15 @@ pub fn main() -> ExitCode {
             if is_broken_pipe(&err) {
                 return ExitCode::SUCCESS;
             }
-            eprintln!("patchtrace: {err}");
-            let mut source = err.source();
-            while let Some(s) = source {
-                eprintln!("  caused by: {s}");
-                source = s.source();
+            let message = err.to_string();
+            eprintln!("patchtrace: {message}");
+            // Causes whose text the message already includes (a path-prefixed I/O error)
+            // are not repeated.
+            for cause in err.chain().skip(1) {
+                let text = cause.to_string();
+                if !message.contains(&text) {
+                    eprintln!("  caused by: {text}");
+                }
             }
             ExitCode::from(exit_code_for(&err))
         }

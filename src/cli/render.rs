@@ -7,9 +7,9 @@ use std::time::Instant;
 use anyhow::bail;
 use serde::Serialize;
 
-use crate::cli::args::RenderArgs;
+use crate::cli::args::{Aov, RenderArgs};
 use crate::cli::setup::{precision, prepare, thread_pool};
-use crate::render::film::ImageFormat;
+use crate::render::film::{ImageFormat, write_effort};
 use crate::render::integrator::{Integrator, TraceSettings};
 use crate::render::plan::EffectPlan;
 use crate::render::renderer::{progress_bar, render_image};
@@ -38,6 +38,15 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     if args.width == Some(0) || args.height == Some(0) {
         bail!("--width and --height must be at least 1");
     }
+    if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if !dir.is_dir() {
+            return Err(LoadError::invalid(
+                &args.output,
+                format!("the directory {} does not exist", dir.display()),
+            )
+            .into());
+        }
+    }
     let pool = thread_pool(args.threads)?;
     let mut prepared = prepare(&args.scene, &args.kernel)?;
     let scene = &mut prepared.scene;
@@ -60,10 +69,21 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     };
     let bar = progress_bar(args.quiet, "rendering");
     let start = Instant::now();
-    let (film, tally) = pool.install(|| render_image(&integrator, &bar));
+    let rendered = pool.install(|| render_image(&integrator, &bar));
+    let (film, tally) = (&rendered.film, &rendered.tally);
     let render_seconds = start.elapsed().as_secs_f64();
     let start = Instant::now();
     film.write(&args.output)?;
+    if args.aov.contains(&Aov::Effort) {
+        let [exr, png] = write_effort(&args.output, film.width, film.height, &rendered.effort)?;
+        if !args.quiet {
+            eprintln!(
+                "wrote effort (splits per pixel) to {} and {}",
+                exr.display(),
+                png.display()
+            );
+        }
+    }
     let write_seconds = start.elapsed().as_secs_f64();
     if args.stats {
         let mut out = std::io::stdout().lock();

@@ -14,8 +14,16 @@ use super::stats::RayTally;
 /// large enough that scheduling costs nothing.
 const TILE: u32 = 16;
 
+/// A rendered image, the ray statistics, and the effort per pixel: de Casteljau splits of
+/// all rays the pixel started (Dammertz Fig. 2.9), row-major.
+pub struct Rendered {
+    pub film: Film,
+    pub tally: RayTally,
+    pub effort: Vec<u32>,
+}
+
 /// Traces every pixel of the scene camera. `progress` is advanced per tile.
-pub fn render_image(integrator: &Integrator, progress: &ProgressBar) -> (Film, RayTally) {
+pub fn render_image(integrator: &Integrator, progress: &ProgressBar) -> Rendered {
     let cam = &integrator.scene.camera;
     let (width, height) = (cam.width, cam.height);
     let rays = CameraRays::new(cam);
@@ -23,7 +31,7 @@ pub fn render_image(integrator: &Integrator, progress: &ProgressBar) -> (Film, R
         .flat_map(|ty| (0..width.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
     progress.set_length(tiles.len() as u64);
-    let results: Vec<(u32, u32, Vec<Vec4>, RayTally)> = tiles
+    let results: Vec<(u32, u32, Vec<(Vec4, u32)>, RayTally)> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
             let mut tally = RayTally::default();
@@ -31,7 +39,9 @@ pub fn render_image(integrator: &Integrator, progress: &ProgressBar) -> (Film, R
             let mut px = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
             for y in y0..y1 {
                 for x in x0..x1 {
-                    px.push(integrator.primary(&rays.ray(x, y), &mut tally));
+                    let before = tally.splits();
+                    let color = integrator.primary(&rays.ray(x, y), &mut tally);
+                    px.push((color, (tally.splits() - before).min(u32::MAX as u64) as u32));
                 }
             }
             progress.inc(1);
@@ -43,17 +53,24 @@ pub fn render_image(integrator: &Integrator, progress: &ProgressBar) -> (Film, R
         height,
         pixels: vec![Vec4::ZERO; (width * height) as usize],
     };
+    let mut effort = vec![0; (width * height) as usize];
     let mut total = RayTally::default();
     for (x0, y0, px, tally) in results {
         let w = (x0 + TILE).min(width) - x0;
-        for (k, p) in px.into_iter().enumerate() {
+        for (k, (color, splits)) in px.into_iter().enumerate() {
             let (x, y) = (x0 + k as u32 % w, y0 + k as u32 / w);
-            film.pixels[(y * width + x) as usize] = p;
+            let i = (y * width + x) as usize;
+            film.pixels[i] = color;
+            effort[i] = splits;
         }
         total = total.merge(tally);
     }
     progress.finish_and_clear();
-    (film, total)
+    Rendered {
+        film,
+        tally: total,
+        effort,
+    }
 }
 
 /// A progress bar on stderr, hidden when `quiet` or when stderr is not a terminal.

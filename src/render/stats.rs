@@ -97,6 +97,11 @@ impl RayTally {
         self.counts[kind as usize]
     }
 
+    /// de Casteljau splits of all rays recorded so far.
+    pub fn splits(&self) -> u64 {
+        self.splits.sum
+    }
+
     pub fn total(&self) -> u64 {
         self.counts.iter().sum()
     }
