@@ -22,6 +22,9 @@ pub struct Rendered {
     pub effort: Vec<u32>,
 }
 
+/// A traced tile: its corner, (colour, splits) per pixel row-major, and its statistics.
+type TileResult = (u32, u32, Vec<(Vec4, u32)>, RayTally);
+
 /// Traces every pixel of the scene camera. `progress` is advanced per tile.
 pub fn render_image(integrator: &Integrator, progress: &ProgressBar) -> Rendered {
     let cam = &integrator.scene.camera;
@@ -31,7 +34,7 @@ pub fn render_image(integrator: &Integrator, progress: &ProgressBar) -> Rendered
         .flat_map(|ty| (0..width.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
     progress.set_length(tiles.len() as u64);
-    let results: Vec<(u32, u32, Vec<(Vec4, u32)>, RayTally)> = tiles
+    let results: Vec<TileResult> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
             let mut tally = RayTally::default();
