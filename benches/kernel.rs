@@ -4,12 +4,15 @@
 //! threaded, median of several runs after a warm-up.
 //!
 //! `cargo bench --bench kernel` (optionally `-- cross` for the cross-product heuristic,
-//! `size=N` for an N² image, e.g. under callgrind).
+//! `end=K` for the end-game threshold in ulps, `size=N` for an N² image, e.g. under
+//! callgrind). Accuracy is reported as the distance between the `f32` and `f64` hit points
+//! in ulps of the patch's largest coordinate.
 
 use std::path::Path;
 use std::time::Instant;
 
 use glam::DVec3;
+use patchtrace::geom::ulp::ulp_of;
 use patchtrace::kernel::KernelStats;
 use patchtrace::kernel::subdivision::{
     PreparedPatch, SplitHeuristic, SubdivisionConfig, intersect, intersect_f64,
@@ -29,6 +32,12 @@ fn main() {
     let mut cfg = SubdivisionConfig::default();
     if args.iter().any(|a| a == "cross") {
         cfg.heuristic = SplitHeuristic::CrossProduct;
+    }
+    if let Some(k) = args
+        .iter()
+        .find_map(|a| a.strip_prefix("end=")?.parse().ok())
+    {
+        cfg.end_ulps = k;
     }
     let size: u32 = args
         .iter()
@@ -59,8 +68,8 @@ fn main() {
                     continue;
                 }
                 let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
-                if intersect_f64(&patches[k], o, d, 0.0, f64::INFINITY, &cfg).is_some() {
-                    pairs.push((ray, k));
+                if let Some(h) = intersect_f64(&patches[k], o, d, 0.0, f64::INFINITY, &cfg) {
+                    pairs.push((ray, k, o + h.t * d));
                 }
             }
         }
@@ -74,14 +83,20 @@ fn main() {
     let mut stats = KernelStats::default();
     let mut max_splits = 0;
     let mut hits = 0;
+    let mut errors = Vec::new();
     for run in 0..=RUNS {
         let mut s = KernelStats::default();
         let start = Instant::now();
         hits = 0;
-        for (ray, k) in &pairs {
+        errors.clear();
+        for (ray, k, want) in &pairs {
             let before = s.splits;
-            if intersect(&prepared[*k], ray, &cfg, &mut s).is_some() {
+            if let Some(h) = intersect(&prepared[*k], ray, &cfg, &mut s) {
                 hits += 1;
+                let got = (ray.origin + h.t * ray.dir).as_dvec3();
+                let b = prepared[*k].bounds();
+                let scale = b.min.abs().max(b.max.abs()).max_element();
+                errors.push((got - *want).length() / ulp_of(scale));
             }
             max_splits = max_splits.max(s.splits - before);
         }
@@ -112,5 +127,12 @@ fn main() {
         max_splits,
         stats.box_tests as f64 / n,
         median / stats.splits as f64 * 1e9
+    );
+    errors.sort_by(f64::total_cmp);
+    println!(
+        "hit point vs f64 (ulps of the patch scale): mean {:.2}, 99% {:.1}, max {:.1}",
+        errors.iter().sum::<f64>() / errors.len().max(1) as f64,
+        errors.get(errors.len() * 99 / 100).copied().unwrap_or(0.0),
+        errors.last().copied().unwrap_or(0.0)
     );
 }

@@ -1,7 +1,7 @@
 //! Axis-aligned bounding boxes in `f32` (for the kernels and accelerators) and `f64` (for
 //! geometry processing), with a robust ray–box slab test.
 
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec3, Vec3A};
 
 /// Relative error bound of the slab test's `t` values: `(o - x) * inv` rounds twice and the
 /// reciprocal once, so `t_far` is scaled by `1 + 2 γ(3)` with `γ(n) = n ε / (1 - n ε)`
@@ -86,19 +86,40 @@ impl Aabb {
         tmin: f32,
         tmax: f32,
     ) -> Option<(f32, f32)> {
-        let t0 = (self.min - origin) * inv_dir;
-        let t1 = (self.max - origin) * inv_dir;
-        // A zero direction component with the origin exactly on a slab plane gives
-        // 0 * inf = NaN. The ray then lies in the plane, so that slab bounds nothing: NaN
-        // must become -inf for the entry and +inf for the exit. (`min`/`max` alone would
-        // pick the other, infinite operand and wrongly miss the box.)
-        let nan = t0.is_nan_mask() | t1.is_nan_mask();
-        let near = Vec3::select(nan, Vec3::NEG_INFINITY, t0.min(t1));
-        let far = Vec3::select(nan, Vec3::INFINITY, t0.max(t1) * SLAB_FAR_SCALE);
-        let t_enter = near.max_element().max(tmin);
-        let t_exit = far.min_element().min(tmax);
-        (t_enter <= t_exit).then_some((t_enter, t_exit))
+        slab(
+            self.min.into(),
+            self.max.into(),
+            origin.into(),
+            inv_dir.into(),
+            tmin,
+            tmax,
+        )
     }
+}
+
+/// The slab test of [`Aabb::intersect`] on SIMD vectors (`Vec3A` is one SSE register), for
+/// callers that keep their boxes and rays in that form (the subdivision kernel).
+#[inline(always)]
+pub fn slab(
+    min: Vec3A,
+    max: Vec3A,
+    origin: Vec3A,
+    inv_dir: Vec3A,
+    tmin: f32,
+    tmax: f32,
+) -> Option<(f32, f32)> {
+    let t0 = (min - origin) * inv_dir;
+    let t1 = (max - origin) * inv_dir;
+    // A zero direction component with the origin exactly on a slab plane gives
+    // 0 * inf = NaN. The ray then lies in the plane, so that slab bounds nothing: NaN
+    // must become -inf for the entry and +inf for the exit. (`min`/`max` alone would
+    // pick the other, infinite operand and wrongly miss the box.)
+    let nan = t0.is_nan_mask() | t1.is_nan_mask();
+    let near = Vec3A::select(nan, Vec3A::NEG_INFINITY, t0.min(t1));
+    let far = Vec3A::select(nan, Vec3A::INFINITY, t0.max(t1) * SLAB_FAR_SCALE);
+    let t_enter = near.max_element().max(tmin);
+    let t_exit = far.min_element().min(tmax);
+    (t_enter <= t_exit).then_some((t_enter, t_exit))
 }
 
 /// An axis-aligned box in `f64`.

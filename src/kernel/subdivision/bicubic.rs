@@ -2,9 +2,11 @@
 //! the most frequently used degrees"). The net is structure-of-arrays: per coordinate a
 //! 4×4 block of `f32` whose rows (fixed v, u = 0..3) are one SSE register each (glam's
 //! `Vec4` is `__m128` on x86_64 with SSE2). A split in v is de Casteljau across the four
-//! rows, 4 lanes at a time (Dammertz code 2.3.6 does the same on AoS points); a split in u
-//! transposes each block so that the columns become registers, splits, and transposes back.
-//! The box is a lane-wise min/max over the rows followed by a horizontal reduction.
+//! rows, 4 lanes at a time (Dammertz code 2.3.6 does the same on AoS points). A split
+//! along the rows instead transposes each block once and leaves the children transposed
+//! (the net records its orientation), so alternating split directions cost one transpose
+//! per split rather than three. The box is a lane-wise min/max over the rows followed by
+//! a horizontal reduction; it does not depend on the orientation.
 
 use glam::{Mat4, Vec4};
 
@@ -14,13 +16,16 @@ use super::param::Split;
 use super::search::NetStack;
 use crate::geom::{Aabb, BezierPatch};
 
-/// One coordinate of the net: `rows[j]` holds the points (0..4, j).
+/// One coordinate of the net: `rows[j]` holds the points (0..4, j), or when the net is
+/// transposed `rows[i]` holds the points (i, 0..4).
 type Block = [Vec4; 4];
 
 /// A bicubic control net in structure-of-arrays form.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Net {
     pub xyz: [Block; 3],
+    /// Whether the registers hold columns (fixed u) rather than rows (fixed v).
+    pub transposed: bool,
 }
 
 /// De Casteljau at 1/2 across four registers: the same operations in the same order as
@@ -61,7 +66,10 @@ impl Net {
                 xyz[c][j][i] = v;
             }
         }
-        Net { xyz }
+        Net {
+            xyz,
+            transposed: false,
+        }
     }
 
     #[inline(always)]
@@ -75,36 +83,45 @@ impl Net {
     /// Splits at 1/2: `self` becomes the lower half, the upper half is returned.
     #[inline(always)]
     pub fn split_in_place(&mut self, dir: Split) -> Net {
+        // The registers run across the split direction: split them as they are.
+        // Otherwise transpose first, which leaves both children transposed.
+        let across_registers = (dir == Split::V) != self.transposed;
+        if !across_registers {
+            self.transposed = !self.transposed;
+        }
         let mut upper = [[Vec4::ZERO; 4]; 3];
         for (b, up) in self.xyz.iter_mut().zip(upper.iter_mut()) {
-            match dir {
-                Split::V => {
-                    let (lo, hi) = split4(*b);
-                    *b = lo;
-                    *up = hi;
-                }
-                Split::U => {
-                    let (lo, hi) = split4(transpose(*b));
-                    *b = transpose(lo);
-                    *up = transpose(hi);
-                }
-            }
+            let rows = if across_registers { *b } else { transpose(*b) };
+            (*b, *up) = split4(rows);
         }
-        Net { xyz: upper }
+        Net {
+            xyz: upper,
+            transposed: self.transposed,
+        }
     }
 
     /// Point (i, j) of the net.
     pub fn point(&self, i: usize, j: usize) -> [f32; 3] {
-        [self.xyz[0][j][i], self.xyz[1][j][i], self.xyz[2][j][i]]
+        let (r, l) = if self.transposed { (i, j) } else { (j, i) };
+        [self.xyz[0][r][l], self.xyz[1][r][l], self.xyz[2][r][l]]
     }
 
     #[inline(always)]
     fn corners(&self) -> Corners<f32> {
         let [x, y, z] = &self.xyz;
+        // Points (0,0), (3,0) and (0,3): lane 3 of register 0 and lane 0 of register 3
+        // swap roles in a transposed net.
+        let first_lane_end = [x[0].w, y[0].w, z[0].w];
+        let last_register = [x[3].x, y[3].x, z[3].x];
+        let (pn0, p0m) = if self.transposed {
+            (last_register, first_lane_end)
+        } else {
+            (first_lane_end, last_register)
+        };
         Corners {
             p00: [x[0].x, y[0].x, z[0].x],
-            pn0: [x[0].w, y[0].w, z[0].w],
-            p0m: [x[3].x, y[3].x, z[3].x],
+            pn0,
+            p0m,
         }
     }
 }
@@ -195,6 +212,31 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn transposed_nets_match_bezier_splits() {
+        // u twice: the first split leaves the net transposed, the second splits it as it
+        // is; points and corners must still be those of the de Casteljau sub-patch.
+        let p = patch();
+        let want = p.split_u().1.split_u().0;
+        let mut net = Net::from_patch(&p);
+        let mut upper = net.split_in_place(Split::U);
+        assert!(upper.transposed);
+        upper.split_in_place(Split::U);
+        assert!(upper.transposed);
+        for j in 0..4 {
+            for i in 0..4 {
+                let (g, w) = (upper.point(i, j), want.point(i, j));
+                for c in 0..3 {
+                    let tol = 4.0 * crate::geom::ulp::ulp_of(w[c].abs().max(4.0) as f32);
+                    assert!((g[c] as f64 - w[c]).abs() <= tol, "{g:?} vs {w:?}");
+                }
+            }
+        }
+        let c = upper.corners();
+        assert_eq!(c.pn0, upper.point(3, 0));
+        assert_eq!(c.p0m, upper.point(0, 3));
     }
 
     #[test]

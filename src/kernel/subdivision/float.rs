@@ -3,8 +3,9 @@
 //! implemented using double precision arithmetic"). The trait adds to [`Real`] what the
 //! search needs: neighbours of a float, ulp distances, and the robust ray–box slab test.
 
-use glam::{DVec3, Vec3};
+use glam::{DVec3, Vec3, Vec3A};
 
+use crate::geom::bbox::slab;
 use crate::geom::real::Real;
 use crate::geom::ulp::ulp_distance;
 use crate::geom::{Aabb, DAabb};
@@ -52,9 +53,11 @@ impl KernelFloat for f32 {
     }
     #[inline(always)]
     fn slab(b: &GBox<f32>, ray: &GRay<f32>, tmax: f32) -> Option<(f32, f32)> {
-        b.to_aabb().intersect(
-            Vec3::from_array(ray.origin),
-            Vec3::from_array(ray.inv_dir),
+        slab(
+            Vec3A::from_array(b.min),
+            Vec3A::from_array(b.max),
+            Vec3A::from_array(ray.origin),
+            Vec3A::from_array(ray.inv_dir),
             ray.tmin,
             tmax,
         )

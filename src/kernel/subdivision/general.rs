@@ -37,22 +37,34 @@ pub struct Scratch<T> {
 }
 
 /// The box of a homogeneous net: exact for integral nets, rounded outward after the
-/// division for rational ones.
+/// division for rational ones. The rational test is hoisted out of the point loop and the
+/// bounds grow by plain comparisons (control points are finite, so the NaN handling of
+/// `min`/`max` is not needed): this loop is most of a split of a low-degree patch.
 pub fn net_box<T: KernelFloat>(net: &[[T; 4]], rational: bool) -> GBox<T> {
     let mut b = GBox {
         min: [T::INFINITY; 3],
         max: [-T::INFINITY; 3],
     };
-    for p in net {
-        for c in 0..3 {
-            let (lo, hi) = if rational {
+    let mut grow = |c: usize, lo: T, hi: T| {
+        if lo < b.min[c] {
+            b.min[c] = lo;
+        }
+        if hi > b.max[c] {
+            b.max[c] = hi;
+        }
+    };
+    if rational {
+        for p in net {
+            for c in 0..3 {
                 let x = p[c] / p[3];
-                (x.next_down(), x.next_up())
-            } else {
-                (p[c], p[c])
-            };
-            b.min[c] = b.min[c].min(lo);
-            b.max[c] = b.max[c].max(hi);
+                grow(c, x.next_down(), x.next_up());
+            }
+        }
+    } else {
+        for p in net {
+            for c in 0..3 {
+                grow(c, p[c], p[c]);
+            }
         }
     }
     b

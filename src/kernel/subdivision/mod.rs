@@ -11,8 +11,9 @@
 //!   parameter cells (and the depth bound that guarantees termination), scalar types.
 //!
 //! No fixed epsilon appears anywhere: termination is the box's own precision (the L1
-//! diameter stops shrinking, or for rational patches the box corners come within
-//! `rational_dist` ulps), and depth is bounded by the parameter cell ([`param`]).
+//! diameter stops shrinking, or falls below `end_ulps` ulps of the patch's coordinates, or
+//! for rational patches the box corners come within `rational_dist` ulps), and depth is
+//! bounded by the parameter cell ([`param`]).
 
 pub mod bicubic;
 pub mod config;
@@ -26,7 +27,7 @@ pub mod search;
 
 use std::cell::RefCell;
 
-pub use config::{DEFAULT_RATIONAL_DIST, SplitHeuristic, SubdivisionConfig};
+pub use config::{DEFAULT_END_ULPS, DEFAULT_RATIONAL_DIST, SplitHeuristic, SubdivisionConfig};
 pub use prepared::PreparedPatch;
 pub use reference::{PatchHit64, intersect_f64};
 

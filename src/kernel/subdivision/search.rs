@@ -7,7 +7,8 @@
 //! storage writes the children where they belong). A child whose box did not shrink in the
 //! L1 diameter (§2.3.3: a convex combination of neighbouring floats returns one of them, so
 //! the box stops changing at full precision) or, for a rational patch, whose box corners
-//! are within the mantissa distance (§2.7.2), or whose parameter cell reached the depth
+//! are within the mantissa distance (§2.7.2), or whose L1 diameter is below the end-game
+//! threshold ([`SubdivisionConfig::end_ulps`]), or whose parameter cell reached the depth
 //! limit ([`super::param`]), is a final box: a hit at its entry `t`, which shortens the ray
 //! so that farther stack entries are dropped.
 
@@ -76,6 +77,7 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
     };
     let mut best: Option<SearchHit<T>> = None;
     let max = T::MAX_LEVEL;
+    let end_diameter = end_game_diameter(&root, cfg.end_ulps);
     loop {
         // A popped entry was tested against an older, longer ray; after a hit only strictly
         // nearer boxes matter.
@@ -108,11 +110,13 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
                 let cell = if i == 0 { cells.0 } else { cells.1 };
                 let (lu, lv) = cell.levels();
                 let b = boxes[i];
+                let bd = b.l1_diameter();
                 Node {
                     bbox: b,
                     t_enter,
                     cell,
-                    is_final: b.l1_diameter() >= d
+                    is_final: bd >= d
+                        || bd < end_diameter
                         || (lu >= max && lv >= max)
                         || (rational && b.mantissa_close(cfg.rational_dist)),
                 }
@@ -151,4 +155,19 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
             None => return best,
         }
     }
+}
+
+/// The L1 diameter below which a box is final: `end_ulps` ulps of the largest coordinate
+/// magnitude of the root box. The net's rounding error grows from that scale (every de
+/// Casteljau average rounds to it), so a box narrower than a few of its ulps is noise.
+fn end_game_diameter<T: KernelFloat>(root: &GBox<T>, end_ulps: u32) -> T {
+    let scale = (0..3)
+        .map(|i| {
+            root.min[i]
+                .max(-root.min[i])
+                .max(root.max[i])
+                .max(-root.max[i])
+        })
+        .fold(T::ZERO, |a, b| a.max(b));
+    (scale.next_up() - scale) * T::from_f64(end_ulps as f64)
 }
