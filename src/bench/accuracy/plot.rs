@@ -5,6 +5,9 @@ use plotters::prelude::*;
 
 use super::MethodResult;
 
+/// Vertical offset of a point's label on the log error axis, as a factor.
+const LABEL_LIFT: f64 = 1.35;
+
 /// Indices of the Pareto-optimal results: no other result is at least as fast and at
 /// least as accurate, and strictly better in one.
 pub fn pareto_front(results: &[MethodResult]) -> Vec<usize> {
@@ -68,6 +71,8 @@ pub fn svg(results: &[MethodResult], title: &str) -> Result<String, String> {
             .configure_mesh()
             .x_desc("time per ray (ns)")
             .y_desc("mean hit-point error (L1, scene units)")
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .y_label_formatter(&|v| format!("{v:.0e}"))
             .draw()
             .map_err(e)?;
         let front: Vec<(f64, f64)> = pareto_front(results)
@@ -86,12 +91,18 @@ pub fn svg(results: &[MethodResult], title: &str) -> Result<String, String> {
                     .map(|r| Circle::new(point(r), 5, BLUE.filled())),
             )
             .map_err(e)?;
+        // Labels alternate above and below their points (a constant factor on the log
+        // axis) so that neighbours do not overprint.
         chart
-            .draw_series(
-                results
-                    .iter()
-                    .map(|r| Text::new(format!("  {}", r.method), point(r), ("sans-serif", 13))),
-            )
+            .draw_series(results.iter().enumerate().map(|(i, r)| {
+                let (x, y) = point(r);
+                let lift = if i % 2 == 0 {
+                    LABEL_LIFT
+                } else {
+                    1.0 / LABEL_LIFT
+                };
+                Text::new(format!("  {}", r.method), (x, y * lift), ("sans-serif", 14))
+            }))
             .map_err(e)?;
         chart
             .configure_series_labels()
