@@ -10,6 +10,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod accel;
+pub mod bench;
 pub mod cli;
 pub mod geom;
 pub mod kernel;

@@ -4,6 +4,7 @@
 //! or invalid files), 1 for other failures.
 
 pub mod args;
+mod bench;
 mod bvh;
 mod convert;
 mod import;
@@ -57,6 +58,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Trace(a) => trace::run(a),
         Command::Tessellate(a) => tessellate::run(a),
         Command::Scene(args::SceneCommand::Teapots(a)) => scene_gen::teapots(a),
+        Command::Bench(args::BenchCommand::Stability(a)) => bench::stability(a),
     }
 }
 
