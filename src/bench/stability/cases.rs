@@ -77,37 +77,89 @@ pub fn all_cases(size: SuiteSize, seed: u64) -> Vec<Case> {
     let teapot = teapot();
     let sphere = sphere_patches();
     let mut cases = vec![
-        case("sphere grazing", &sphere, grazing_rays(&sphere, n, &mut rng)),
-        case("sphere tangent", &sphere, tangent_rays(&sphere, n, &mut rng)),
+        case(
+            "sphere grazing",
+            &sphere,
+            grazing_rays(&sphere, n, &mut rng),
+        ),
+        case(
+            "sphere tangent",
+            &sphere,
+            tangent_rays(&sphere, n, &mut rng),
+        ),
         case("sphere silhouette", &sphere, silhouette_rays(n, &mut rng)),
-        case("grid 2x2 corners+edges", &grid_2x2(), seam_rays(&grid_2x2(), n, &mut rng)),
-        case("teapot corners+edges", &teapot, seam_rays(&teapot, n, &mut rng)),
-        case("teapot collapsed edges", &teapot, collapsed_rays(&teapot, n, &mut rng)),
+        case(
+            "grid 2x2 corners+edges",
+            &grid_2x2(),
+            seam_rays(&grid_2x2(), n, &mut rng),
+        ),
+        case(
+            "teapot corners+edges",
+            &teapot,
+            seam_rays(&teapot, n, &mut rng),
+        ),
+        case(
+            "teapot collapsed edges",
+            &teapot,
+            collapsed_rays(&teapot, n, &mut rng),
+        ),
     ];
     let curve = vec![curve_patch()];
-    cases.push(case("patch collapsed to a curve", &curve, curve_rays(&curve[0], n, &mut rng)));
+    cases.push(case(
+        "patch collapsed to a curve",
+        &curve,
+        curve_rays(&curve[0], n, &mut rng),
+    ));
     let planar = nearly_planar(&mut rng);
-    cases.push(case("nearly planar, any orientation", &planar, random_rays(&planar, n, &mut rng)));
+    cases.push(case(
+        "nearly planar, any orientation",
+        &planar,
+        random_rays(&planar, n, &mut rng),
+    ));
     let folded = folded_patches();
-    cases.push(case("self-intersecting + folded", &folded, random_rays(&folded, n, &mut rng)));
+    cases.push(case(
+        "self-intersecting + folded",
+        &folded,
+        random_rays(&folded, n, &mut rng),
+    ));
     let high = vec![degree_10x7(&mut rng)];
     cases.push(case("degree 10x7", &high, random_rays(&high, n, &mut rng)));
     let rational = rational_patches(&mut rng);
-    cases.push(case("rational, weights 1e-3..1e3", &rational, random_rays(&rational, n, &mut rng)));
+    cases.push(case(
+        "rational, weights 1e-3..1e3",
+        &rational,
+        random_rays(&rational, n, &mut rng),
+    ));
     for s in TEAPOT_SCALES {
         let p = transformed(&teapot, DAffine3::from_scale(DVec3::splat(s)));
-        cases.push(case(&format!("teapot x{s:e}"), &p, random_rays(&p, n, &mut rng)));
+        cases.push(case(
+            &format!("teapot x{s:e}"),
+            &p,
+            random_rays(&p, n, &mut rng),
+        ));
     }
     for d in TEAPOT_OFFSETS {
         let offset = DVec3::new(1.0, 0.6, 0.3).normalize() * d;
         let p = transformed(&teapot, DAffine3::from_translation(offset));
-        cases.push(case(&format!("teapot at {d:e} from origin"), &p, random_rays(&p, n, &mut rng)));
+        cases.push(case(
+            &format!("teapot at {d:e} from origin"),
+            &p,
+            random_rays(&p, n, &mut rng),
+        ));
     }
     let pair = tiny_beside_huge();
-    cases.push(case("tiny beside huge (1e6)", &pair, random_rays(&pair, n, &mut rng)));
+    cases.push(case(
+        "tiny beside huge (1e6)",
+        &pair,
+        random_rays(&pair, n, &mut rng),
+    ));
     for s in [NEAR_SUBNORMAL_SCALE, SUBNORMAL_SCALE] {
         let p = transformed(&teapot, DAffine3::from_scale(DVec3::splat(s)));
-        cases.push(case(&format!("teapot x{s:e} (subnormal range)"), &p, random_rays(&p, n, &mut rng)));
+        cases.push(case(
+            &format!("teapot x{s:e} (subnormal range)"),
+            &p,
+            random_rays(&p, n, &mut rng),
+        ));
     }
     cases
 }
@@ -115,7 +167,10 @@ pub fn all_cases(size: SuiteSize, seed: u64) -> Vec<Case> {
 /// A case scene: the patches rounded to `f32`, framed by the default camera and light, with
 /// a material that reflects and refracts so that renders trace every kind of ray.
 fn case(name: &str, patches: &[BezierPatch], rays: Vec<Ray>) -> Case {
-    let surfaces = patches.iter().map(|p| Surface::bezier(round_to_f32(p))).collect();
+    let surfaces = patches
+        .iter()
+        .map(|p| Surface::bezier(round_to_f32(p)))
+        .collect();
     let mut scene = Scene::framing(vec![Object {
         name: name.to_string(),
         material: 0,
@@ -139,7 +194,11 @@ fn case(name: &str, patches: &[BezierPatch], rays: Vec<Ray>) -> Case {
 /// overflows `f32` would fail [`BezierPatch::new`], and the patch is then kept unrounded so
 /// the kernel's own handling shows in the figures.
 fn round_to_f32(p: &BezierPatch) -> BezierPatch {
-    let points = p.homogeneous_points().iter().map(|q| q.as_vec4().as_dvec4()).collect();
+    let points = p
+        .homogeneous_points()
+        .iter()
+        .map(|q| q.as_vec4().as_dvec4())
+        .collect();
     BezierPatch::new(p.degree_u(), p.degree_v(), points).unwrap_or_else(|_| p.clone())
 }
 
@@ -166,7 +225,9 @@ fn teapot() -> Vec<BezierPatch> {
 /// The 8 rational biquadratic patches of the unit sphere: convex, with collapsed edges at
 /// the poles.
 fn sphere_patches() -> Vec<BezierPatch> {
-    sphere(1.0).map(|s| s.to_bezier_patches()).unwrap_or_default()
+    sphere(1.0)
+        .map(|s| s.to_bezier_patches())
+        .unwrap_or_default()
 }
 
 /// A patch of degree (du, dv) whose control point (i, j) is `f(i / du, j / dv)`.
@@ -194,7 +255,9 @@ fn grid_2x2() -> Vec<BezierPatch> {
 
 /// A bicubic patch whose net is one curve repeated: the surface is that space curve.
 fn curve_patch() -> BezierPatch {
-    net(3, 3, |s, _| DVec3::new(2.0 * s - 1.0, 0.5 * (3.0 * s).sin(), 0.3 * s * s))
+    net(3, 3, |s, _| {
+        DVec3::new(2.0 * s - 1.0, 0.5 * (3.0 * s).sin(), 0.3 * s * s)
+    })
 }
 
 /// Four bicubic patches with control points on a plane, displaced off it by 1e-7 of their
@@ -244,7 +307,9 @@ fn degree_10x7(rng: &mut SplitMix64) -> BezierPatch {
 fn rational_patches(rng: &mut SplitMix64) -> Vec<BezierPatch> {
     (0..3)
         .map(|k| {
-            let base = net(3, 3, |s, t| DVec3::new(s + 1.2 * k as f64, t, 0.5 * s * (1.0 - t)));
+            let base = net(3, 3, |s, t| {
+                DVec3::new(s + 1.2 * k as f64, t, 0.5 * s * (1.0 - t))
+            });
             let points: Vec<DVec3> = base.euclidean_points().collect();
             let (lo, hi) = (WEIGHT_MIN.ln(), WEIGHT_MAX.ln());
             let weights: Vec<f64> = points.iter().map(|_| rng.range(lo, hi).exp()).collect();
@@ -258,7 +323,9 @@ fn tiny_beside_huge() -> Vec<BezierPatch> {
     let huge = 1e3;
     let tiny = huge / TINY_HUGE_RATIO;
     let dome = |size: f64, x0: f64| {
-        net(3, 3, move |s, t| DVec3::new(x0 + size * s, size * t, 0.3 * size * s * (1.0 - t)))
+        net(3, 3, move |s, t| {
+            DVec3::new(x0 + size * s, size * t, 0.3 * size * s * (1.0 - t))
+        })
     };
     vec![dome(huge, 0.0), dome(tiny, huge + tiny)]
 }
@@ -269,9 +336,9 @@ fn tiny_beside_huge() -> Vec<BezierPatch> {
 
 /// Centre and radius of the patches' control boxes.
 fn extent(patches: &[BezierPatch]) -> (DVec3, f64) {
-    let b = patches
-        .iter()
-        .fold(crate::geom::DAabb::EMPTY, |acc, p| acc.union(&p.control_box()));
+    let b = patches.iter().fold(crate::geom::DAabb::EMPTY, |acc, p| {
+        acc.union(&p.control_box())
+    });
     (b.center(), 0.5 * b.diagonal())
 }
 
@@ -403,7 +470,11 @@ fn collapsed_rays(patches: &[BezierPatch], n: usize, rng: &mut SplitMix64) -> Ve
     (0..n)
         .map(|k| {
             let (p, (along_v, side)) = degenerate[rng.next_u64() as usize % degenerate.len()];
-            let gap = if k % 4 == 0 { 0.0 } else { 10f64.powf(rng.range(-9.0, -1.0)) };
+            let gap = if k % 4 == 0 {
+                0.0
+            } else {
+                10f64.powf(rng.range(-9.0, -1.0))
+            };
             let near = (side - gap).abs().min(1.0);
             let free = rng.unit();
             let (u, v) = if along_v { (free, near) } else { (near, free) };

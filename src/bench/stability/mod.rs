@@ -62,7 +62,10 @@ impl Figures {
             (self.non_finite_normals > 0, Criterion::NonFiniteNormals),
             (self.nan_pixels > 0, Criterion::NanPixels),
             (splits_unbounded, Criterion::Splits),
-            (self.distance_median > MAX_MEDIAN_ULPS, Criterion::MedianDistance),
+            (
+                self.distance_median > MAX_MEDIAN_ULPS,
+                Criterion::MedianDistance,
+            ),
         ]
         .into_iter()
         .filter_map(|(failed, c)| failed.then_some(c))

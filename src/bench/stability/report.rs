@@ -29,7 +29,10 @@ const HEADERS: [&str; 16] = [
 fn cells(r: &CaseResult) -> Vec<String> {
     let f = &r.figures;
     let splits = match f.splits {
-        Some(s) => [format!("{:.1}", s.mean), format!("{} ({})", s.max, s.max_per_patch)],
+        Some(s) => [
+            format!("{:.1}", s.mean),
+            format!("{} ({})", s.max, s.max_per_patch),
+        ],
         None => ["n/a".to_string(), "n/a".to_string()],
     };
     let [splits_mean, splits_max] = splits;
@@ -58,7 +61,11 @@ fn failures(r: &CaseResult) -> String {
     if fails.is_empty() {
         "ok".to_string()
     } else {
-        fails.iter().map(|c| c.to_string()).collect::<Vec<_>>().join("; ")
+        fails
+            .iter()
+            .map(|c| c.to_string())
+            .collect::<Vec<_>>()
+            .join("; ")
     }
 }
 
@@ -89,7 +96,11 @@ pub fn csv(results: &[CaseResult]) -> String {
     for r in results {
         let f = &r.figures;
         let (mean, max, per) = match f.splits {
-            Some(s) => (s.mean.to_string(), s.max.to_string(), s.max_per_patch.to_string()),
+            Some(s) => (
+                s.mean.to_string(),
+                s.max.to_string(),
+                s.max_per_patch.to_string(),
+            ),
             None => Default::default(),
         };
         let fails = r.figures.failures();
