@@ -34,12 +34,41 @@ pub enum Command {
     /// Render the exact surfaces and triangle tessellations of a scene, diff them, and
     /// tabulate accuracy against cost.
     Compare(CompareArgs),
-    /// Benchmarks: accuracy against time.
-    #[command(subcommand)]
-    Bench(BenchCommand),
     /// Generate test scenes.
     #[command(subcommand)]
     Scene(SceneCommand),
+    /// Measure the kernels: reports as tables.
+    #[command(subcommand)]
+    Bench(BenchCommand),
+}
+
+#[derive(Debug, Subcommand)]
+pub enum BenchCommand {
+    /// Every method against the f64 reference: hit and normal error, holes, false hits,
+    /// time per ray and memory, as a table, CSV and a log-log plot with the Pareto front.
+    Accuracy(AccuracyArgs),
+    /// Numerical stability on hard cases (grazing, tangent and silhouette rays, shared edges,
+    /// collapsed and folded patches, extreme scales and weights) against the f64
+    /// reference: holes, false hits, self-hits, hit distance, splits and NaN pixels per
+    /// kernel path, as a Markdown table on stdout.
+    Stability(StabilityArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct StabilityArgs {
+    /// Run the full suite (2000 rays per case, 64x64 renders) instead of the reduced one
+    /// that `cargo test` runs (48 rays, 16x16).
+    #[arg(long)]
+    pub full: bool,
+    /// Random seed: the same seed gives the same cases and rays.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Also write the table as CSV to this file.
+    #[arg(long, value_name = "FILE")]
+    pub csv: Option<PathBuf>,
+    /// Hide the progress bar.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 #[derive(Debug, Subcommand)]
@@ -307,12 +336,6 @@ pub struct CompareArgs {
     pub quiet: bool,
 }
 
-#[derive(Debug, Subcommand)]
-pub enum BenchCommand {
-    /// Every method against the f64 reference: hit and normal error, holes, false hits,
-    /// time per ray and memory, as a table, CSV and a log-log plot with the Pareto front.
-    Accuracy(AccuracyArgs),
-}
 
 #[derive(Debug, Args)]
 pub struct AccuracyArgs {

@@ -5,6 +5,7 @@
 
 pub mod args;
 mod bench_accuracy;
+mod bench;
 mod bvh;
 mod compare;
 mod convert;
@@ -67,6 +68,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Compare(a) => compare::run(a),
         Command::Bench(args::BenchCommand::Accuracy(a)) => bench_accuracy::run(a),
         Command::Scene(args::SceneCommand::Teapots(a)) => scene_gen::teapots(a),
+        Command::Bench(args::BenchCommand::Stability(a)) => bench::stability(a),
     }
 }
 

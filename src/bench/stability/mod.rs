@@ -1,0 +1,108 @@
+//! The numerical stability suite (issue 7): hard cases ([`cases`]) run against every kernel
+//! path and compared ray by ray with the `f64` reference ([`run`]), summarised as a
+//! Markdown or CSV table ([`report`]). The acceptance criteria of the float-precision
+//! kernel are [`Criterion`]s, checked by `tests/stability_suite.rs` on the reduced suite.
+
+pub mod cases;
+pub mod report;
+pub mod run;
+
+use std::fmt;
+
+use indicatif::ProgressBar;
+
+pub use cases::{Case, SuiteSize, all_cases};
+pub use run::{BOX_TOLERANCE_ULPS, Figures, KernelPath, SplitFigures, run_case};
+
+/// Largest median distance from the reference hit, in ulps of the hit's largest coordinate
+/// (issue 7, "done when").
+pub const MAX_MEDIAN_ULPS: f64 = 4.0;
+
+/// Largest number of de Casteljau splits one ray–patch test may take. The kernel's search
+/// is at most `2 · 32` splits deep in `f32` (src/kernel/subdivision/param.rs); the search
+/// visits more than one path only where several sub-boxes overlap the ray.
+pub const MAX_SPLITS_PER_PATCH_TEST: u64 = 4096;
+
+/// One acceptance criterion of issue 7 for the float-precision kernel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Criterion {
+    Holes,
+    FalseHits,
+    SelfHits,
+    NonFiniteNormals,
+    NanPixels,
+    Splits,
+    MedianDistance,
+}
+
+impl fmt::Display for Criterion {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Criterion::Holes => "holes",
+            Criterion::FalseHits => "false hits",
+            Criterion::SelfHits => "self-hits",
+            Criterion::NonFiniteNormals => "non-finite normals",
+            Criterion::NanPixels => "NaN pixels",
+            Criterion::Splits => "splits",
+            Criterion::MedianDistance => "median distance",
+        })
+    }
+}
+
+impl Figures {
+    /// The criteria these figures fail.
+    pub fn failures(&self) -> Vec<Criterion> {
+        let splits_unbounded = self
+            .splits
+            .is_some_and(|s| s.max_per_patch > MAX_SPLITS_PER_PATCH_TEST);
+        [
+            (self.holes > 0, Criterion::Holes),
+            (self.false_hits > 0, Criterion::FalseHits),
+            (self.self_hits > 0, Criterion::SelfHits),
+            (self.non_finite_normals > 0, Criterion::NonFiniteNormals),
+            (self.nan_pixels > 0, Criterion::NanPixels),
+            (splits_unbounded, Criterion::Splits),
+            (
+                self.distance_median > MAX_MEDIAN_ULPS,
+                Criterion::MedianDistance,
+            ),
+        ]
+        .into_iter()
+        .filter_map(|(failed, c)| failed.then_some(c))
+        .collect()
+    }
+}
+
+/// The figures of one case on one kernel path.
+#[derive(Clone, Debug)]
+pub struct CaseResult {
+    pub case: String,
+    pub path: KernelPath,
+    pub figures: Figures,
+}
+
+/// Runs every case on every path in `paths`, advancing `progress` once per (case, path).
+pub fn run_suite(
+    size: SuiteSize,
+    seed: u64,
+    paths: &[KernelPath],
+    progress: &ProgressBar,
+) -> Vec<CaseResult> {
+    let cases = all_cases(size, seed);
+    progress.set_length((cases.len() * paths.len()) as u64);
+    let mut results = Vec::new();
+    for (k, case) in cases.iter().enumerate() {
+        for &path in paths {
+            progress.set_message(format!("{} ({})", case.name, path.name()));
+            let figures = run_case(case, path, size.image_size(), seed ^ k as u64);
+            results.push(CaseResult {
+                case: case.name.clone(),
+                path,
+                figures,
+            });
+            progress.inc(1);
+        }
+    }
+    progress.finish_and_clear();
+    results
+}
