@@ -382,7 +382,7 @@ fn nan_pixels(
             plan: EffectPlan::for_scene(&scene),
         },
     };
-    let (film, _) = render_image(&integrator, &ProgressBar::hidden());
+    let film = render_image(&integrator, &ProgressBar::hidden()).film;
     let bad = film.pixels.iter().filter(|p| !p.is_finite()).count();
     (film.pixels.len(), bad)
 }
