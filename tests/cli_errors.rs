@@ -283,3 +283,23 @@ fn coordinates_beyond_f32_after_transforms_are_refused_naming_the_object() {
         "{err}"
     );
 }
+
+#[test]
+fn objects_in_the_subnormal_range_are_refused_naming_the_object() {
+    let text = std::fs::read_to_string(testdata("teapot.ron"))
+        .unwrap()
+        .replace(
+            "material: \"pink\")",
+            "material: \"pink\", transform: [Scale(1e-35)])",
+        )
+        .replace(
+            "File(\"teapot.bpt\")",
+            &format!("File({:?})", testdata("teapot.bpt")),
+        );
+    let c = file("tiny.ron", &text);
+    let err = info_fails(&c.path);
+    assert!(
+        err.contains("object \"teapot\" is only") && err.contains("subnormal"),
+        "{err}"
+    );
+}

@@ -67,3 +67,35 @@ fn f64_path_matches_the_closed_form_on_a_parallelogram() {
     }
     assert!(hits > 100, "only {hits} hits tested");
 }
+
+/// Regression (found by the stability suite): an axis-parallel ray whose origin lies in the
+/// plane of a box face gave 0 · inf = NaN in the kernel's own f64 slab test, which reported
+/// t = 0 (a silhouette "hole" in the reference). The ray x = 0 runs along the patch's edge
+/// plane and must hit at t = 5.
+#[test]
+fn f64_reference_handles_rays_in_a_box_face_plane() {
+    use glam::DVec3;
+    use patchtrace::geom::BezierPatch;
+    use patchtrace::kernel::subdivision::{
+        PreparedPatch, SubdivisionConfig, intersect, intersect_f64,
+    };
+    let corners = [
+        DVec3::new(0.0, 0.0, 0.0),
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(0.0, 1.0, 0.0),
+        DVec3::new(1.0, 1.0, 0.0),
+    ];
+    let patch = BezierPatch::from_points(1, 1, &corners).unwrap();
+    let cfg = SubdivisionConfig::default();
+    for (o, d) in [
+        (DVec3::new(0.0, 0.5, 5.0), DVec3::NEG_Z),
+        (DVec3::new(0.3, 1.0, 5.0), DVec3::NEG_Z),
+    ] {
+        let h = intersect_f64(&patch, o, d, 0.0, f64::INFINITY, &cfg).expect("hit");
+        assert!((h.t - 5.0).abs() < 1e-12, "t = {}", h.t);
+        let mut stats = Default::default();
+        let ray = patchtrace::geom::Ray::new(o.as_vec3(), d.as_vec3());
+        let h = intersect(&PreparedPatch::new(&patch), &ray, &cfg, &mut stats).expect("f32 hit");
+        assert!((h.t - 5.0).abs() < 1e-5, "t = {}", h.t);
+    }
+}

@@ -336,7 +336,6 @@ pub struct CompareArgs {
     pub quiet: bool,
 }
 
-
 #[derive(Debug, Args)]
 pub struct AccuracyArgs {
     /// Scene (.ron) or bare geometry.

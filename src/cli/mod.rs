@@ -4,8 +4,8 @@
 //! or invalid files), 1 for other failures.
 
 pub mod args;
-mod bench_accuracy;
 mod bench;
+mod bench_accuracy;
 mod bvh;
 mod compare;
 mod convert;

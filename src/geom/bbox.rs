@@ -9,6 +9,14 @@ use glam::{DVec3, Vec3, Vec3A};
 /// a box edge from slipping through between two adjacent boxes.
 const SLAB_FAR_SCALE: f32 = 1.0 + 2.0 * gamma3_f32();
 
+/// The same bound for `f64`.
+const SLAB_FAR_SCALE_F64: f64 = 1.0 + 2.0 * gamma3_f64();
+
+const fn gamma3_f64() -> f64 {
+    let e = f64::EPSILON * 0.5;
+    3.0 * e / (1.0 - 3.0 * e)
+}
+
 const fn gamma3_f32() -> f32 {
     let e = f32::EPSILON * 0.5;
     3.0 * e / (1.0 - 3.0 * e)
@@ -159,9 +167,8 @@ impl DAabb {
         (self.min + self.max) * 0.5
     }
 
-    /// The slab test in `f64`, with the same treatment of rays lying in a slab plane as
-    /// [`Aabb::intersect`]. Exact enough without a far-scale: the reference path tests
-    /// every candidate this way.
+    /// The slab test in `f64`, with the same treatment of rays lying in a slab plane and
+    /// the same conservative exit scale as [`Aabb::intersect`]. The f64 kernel uses it.
     pub fn intersect(
         &self,
         origin: DVec3,
@@ -173,7 +180,7 @@ impl DAabb {
         let t1 = (self.max - origin) * inv_dir;
         let nan = t0.is_nan_mask() | t1.is_nan_mask();
         let near = DVec3::select(nan, DVec3::NEG_INFINITY, t0.min(t1));
-        let far = DVec3::select(nan, DVec3::INFINITY, t0.max(t1));
+        let far = DVec3::select(nan, DVec3::INFINITY, t0.max(t1) * SLAB_FAR_SCALE_F64);
         let t_enter = near.max_element().max(tmin);
         let t_exit = far.min_element().min(tmax);
         (t_enter <= t_exit).then_some((t_enter, t_exit))

@@ -74,13 +74,29 @@ pub fn load_scene(path: &Path) -> Result<Scene, LoadError> {
     Ok(scene)
 }
 
+/// Smallest object extent the renderer accepts: 2^-60 ≈ 8.7e-19. Shading squares
+/// distances of about this size in `f32`; below 2^-63 the squares fall under
+/// `f32::MIN_POSITIVE` (2^-126) into the subnormal range and normalising gives NaN.
+pub const MIN_OBJECT_EXTENT: f64 = 1.0 / (1u64 << 60) as f64;
+
 /// The renderer rounds geometry to `f32` once; a coordinate beyond its range would become
-/// infinite there, so it is refused with the object's name.
+/// infinite there, and an object smaller than [`MIN_OBJECT_EXTENT`] would shade in the
+/// subnormal range, so both are refused with the object's name.
 fn check_f32_range(path: &Path, scene: &Scene) -> Result<(), LoadError> {
     for o in &scene.objects {
         let b = o.bounds();
         if b.is_empty() {
             continue;
+        }
+        let extent = b.extent().max_element();
+        if extent > 0.0 && extent < MIN_OBJECT_EXTENT {
+            return Err(LoadError::invalid(
+                path,
+                format!(
+                    "object \"{}\" is only {extent:e} across, below the {MIN_OBJECT_EXTENT:e} that f32 shading resolves (distances would square into the subnormal range); scale the scene up",
+                    o.name
+                ),
+            ));
         }
         let largest = b.min.abs().max(b.max.abs()).max_element();
         if !((largest as f32).is_finite()) {

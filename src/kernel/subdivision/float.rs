@@ -64,11 +64,6 @@ impl KernelFloat for f32 {
     }
 }
 
-/// Relative bound of the `f64` slab test's rounding, `1 + 2 γ(3)`, as for `f32` in
-/// `geom::bbox` (Ize 2013; pbrt-v3 §3.9.2).
-const SLAB_FAR_SCALE_F64: f64 =
-    1.0 + 2.0 * (3.0 * (f64::EPSILON * 0.5)) / (1.0 - 3.0 * (f64::EPSILON * 0.5));
-
 impl KernelFloat for f64 {
     const INFINITY: Self = f64::INFINITY;
     /// 53 mantissa bits and 8 bits of headroom, the most a `u64` fixed-point cell holds.
@@ -103,19 +98,15 @@ impl KernelFloat for f64 {
             .min(u64::MAX as u128) as u64
     }
     fn slab(b: &GBox<f64>, ray: &GRay<f64>, tmax: f64) -> Option<(f64, f64)> {
-        let (min, max) = (DVec3::from_array(b.min), DVec3::from_array(b.max));
+        let b = DAabb {
+            min: DVec3::from_array(b.min),
+            max: DVec3::from_array(b.max),
+        };
         let (o, inv) = (
             DVec3::from_array(ray.origin),
             DVec3::from_array(ray.inv_dir),
         );
-        let t0 = (min - o) * inv;
-        let t1 = (max - o) * inv;
-        // As in `Aabb::intersect`: `min`/`max` drop the NaN of `0 * inf`.
-        let near = t0.min(t1);
-        let far = t0.max(t1) * SLAB_FAR_SCALE_F64;
-        let t_enter = near.max_element().max(ray.tmin);
-        let t_exit = far.min_element().min(tmax);
-        (t_enter <= t_exit).then_some((t_enter, t_exit))
+        b.intersect(o, inv, ray.tmin, tmax)
     }
 }
 
