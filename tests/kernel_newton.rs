@@ -40,7 +40,7 @@ fn random_patch(rng: &mut Rng, rational: bool) -> BezierPatch {
         (3, 3)
     };
     // A random frame and offset so no patch is axis aligned.
-    let a = rng.unit();
+    let a = rng.direction();
     let b = a.any_orthonormal_vector();
     let c = a.cross(b);
     let offset = DVec3::new(
@@ -93,11 +93,13 @@ fn check(rational: bool, patches: usize, rays_per_patch: usize, seed: u64) -> Ta
         for r in 0..rays_per_patch {
             // Most rays aim at a surface point, the rest at a random point of the box.
             let target = if r % 4 != 0 {
-                p.eval(rng.f64(), rng.f64())
+                p.eval(rng.uniform(), rng.uniform())
             } else {
-                cbox.min + (cbox.max - cbox.min) * DVec3::new(rng.f64(), rng.f64(), rng.f64())
+                cbox.min
+                    + (cbox.max - cbox.min)
+                        * DVec3::new(rng.uniform(), rng.uniform(), rng.uniform())
             };
-            let origin = target + rng.unit() * rng.range(3.0, 6.0);
+            let origin = target + rng.direction() * rng.range(3.0, 6.0);
             let dir = (target - origin) * rng.range(0.5, 2.0);
             let ray = Ray::new(origin.as_vec3(), dir.as_vec3());
             let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());

@@ -19,12 +19,13 @@ fn f64_path_matches_the_closed_form_on_a_parallelogram() {
             rng.range(-3.0, 3.0),
             rng.range(-3.0, 3.0),
         );
-        let a = rng.unit() * rng.range(0.5, 2.0);
-        let b = (rng.unit().cross(a).normalize() + 0.3 * rng.unit()) * rng.range(0.5, 2.0);
+        let a = rng.direction() * rng.range(0.5, 2.0);
+        let b =
+            (rng.direction().cross(a).normalize() + 0.3 * rng.direction()) * rng.range(0.5, 2.0);
         let patch = BezierPatch::from_points(1, 1, &[p, p + a, p + b, p + a + b]).unwrap();
         let (u0, v0) = (rng.range(-0.2, 1.2), rng.range(-0.2, 1.2));
         let target = p + u0 * a + v0 * b;
-        let o = target + rng.unit() * rng.range(2.0, 5.0);
+        let o = target + rng.direction() * rng.range(2.0, 5.0);
         let d = (target - o) * rng.range(0.5, 2.0);
         // Closed form: o + t d = p + u a + v b, i.e. [a b -d](u v t)ᵀ = o - p.
         let r = o - p;

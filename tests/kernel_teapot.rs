@@ -96,7 +96,7 @@ fn edge_points(patches: &[BezierPatch], rng: &mut Rng, count: usize) -> Vec<(DVe
             } else {
                 shared[rng.next_u64() as usize % shared.len()]
             };
-            let s = if i % 10 == 0 { 0.5 } else { rng.f64() };
+            let s = if i % 10 == 0 { 0.5 } else { rng.uniform() };
             let (u, v) = uv(e, s);
             (edge(&patches[k], e, s), patches[k].normal(u, v))
         })
@@ -113,7 +113,7 @@ fn rays_at_shared_edges_and_collapsed_points_always_hit() {
     for (target, n) in targets {
         // From outside (20 units away) on either side of the surface, not grazing: the
         // ray must cross the surface at the target or hit something before it.
-        let mut w = rng.unit();
+        let mut w = rng.direction();
         if w.dot(n).abs() < 0.2 {
             w = (w + n.signum() * n * 0.5).normalize();
         }
@@ -159,8 +159,8 @@ fn secondary_rays_do_not_hit_their_own_patch_at_their_origin() {
             let mut hits = 0;
             while hits < 1700 {
                 let k = rng.next_u64() as usize % patches.len();
-                let target = patches[k].eval(rng.f64(), rng.f64());
-                let origin = centre + rng.unit() * 10.0 * scale;
+                let target = patches[k].eval(rng.uniform(), rng.uniform());
+                let origin = centre + rng.direction() * 10.0 * scale;
                 let ray = Ray::new(origin.as_vec3(), (target - origin).as_vec3());
                 let Some((k, h)) = nearest(&prepared, &ray) else {
                     continue;
@@ -177,7 +177,7 @@ fn secondary_rays_do_not_hit_their_own_patch_at_their_origin() {
                 // the hemisphere the origin's corner was chosen for.
                 for outside in [true, false] {
                     let side = if outside { n } else { -n };
-                    let mut d = rng.unit().as_vec3();
+                    let mut d = rng.direction().as_vec3();
                     if d.dot(side) <= 0.0 {
                         d = -d;
                     }

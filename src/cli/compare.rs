@@ -11,6 +11,7 @@ use std::time::Instant;
 use anyhow::Context;
 
 use crate::accel::scene::{Precision, SceneGeometry};
+use crate::bench::accuracy::patch_memory;
 use crate::cli::args::CompareArgs;
 use crate::cli::setup::thread_pool;
 use crate::diff::heatmap::heat_map;
@@ -36,16 +37,6 @@ struct Row {
     psnr: f64,
     flip_mean: f64,
     silhouette_pixels: u64,
-}
-
-/// Bytes of the patches as the kernel stores them: x, y, z (and w when rational) in f32.
-fn patch_bytes(scene: &Scene) -> u64 {
-    scene
-        .objects
-        .iter()
-        .flat_map(|o| o.bezier_patches())
-        .map(|p| p.point_count() as u64 * if p.is_rational() { 16 } else { 12 })
-        .sum()
 }
 
 /// Builds the accelerator and renders, timing both.
@@ -93,7 +84,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     let mut rows = vec![Row {
         method: "direct (f32 subdivision)".into(),
         triangles: 0,
-        memory_bytes: patch_bytes(&scene),
+        memory_bytes: patch_memory(&scene),
         build_seconds: build,
         render_seconds,
         rmse: 0.0,

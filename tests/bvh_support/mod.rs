@@ -5,27 +5,23 @@
 
 use glam::{DVec3, Vec3};
 use patchtrace::geom::{Aabb, Ray};
+use patchtrace::scene::generate::SplitMix64;
 
-/// SplitMix64 (Steele, Lea and Flood 2014): a tiny seeded generator.
-pub struct Rng(u64);
+/// The library's seeded SplitMix64 generator, drawing `f32` values.
+pub struct Rng(SplitMix64);
 
 impl Rng {
     pub fn new(seed: u64) -> Self {
-        Rng(seed)
+        Rng(SplitMix64::new(seed))
     }
 
     pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
+        self.0.next_u64()
     }
 
     /// Uniform in [lo, hi).
     pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        let u = (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32;
-        lo + (hi - lo) * u
+        self.0.range(lo as f64, hi as f64) as f32
     }
 
     pub fn vec(&mut self, lo: f32, hi: f32) -> Vec3 {

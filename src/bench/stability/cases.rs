@@ -354,7 +354,7 @@ fn random_rays(patches: &[BezierPatch], n: usize, rng: &mut SplitMix64) -> Vec<R
     (0..n)
         .map(|_| {
             let p = &patches[rng.next_u64() as usize % patches.len()];
-            let target = p.eval(rng.unit(), rng.unit());
+            let target = p.eval(rng.uniform(), rng.uniform());
             aimed(target, rng.direction(), 3.0 * radius)
         })
         .collect()
@@ -430,8 +430,8 @@ fn seam_rays(patches: &[BezierPatch], n: usize, rng: &mut SplitMix64) -> Vec<Ray
             let corner = |r: &mut SplitMix64| if r.next_u64() % 2 == 0 { 0.0 } else { 1.0 };
             let (u, v) = match k % 3 {
                 0 => (corner(rng), corner(rng)),
-                1 => (corner(rng), rng.unit()),
-                _ => (rng.unit(), corner(rng)),
+                1 => (corner(rng), rng.uniform()),
+                _ => (rng.uniform(), corner(rng)),
             };
             aimed(p.eval(u, v), rng.direction(), 3.0 * radius)
         })
@@ -476,7 +476,7 @@ fn collapsed_rays(patches: &[BezierPatch], n: usize, rng: &mut SplitMix64) -> Ve
                 10f64.powf(rng.range(-9.0, -1.0))
             };
             let near = (side - gap).abs().min(1.0);
-            let free = rng.unit();
+            let free = rng.uniform();
             let (u, v) = if along_v { (free, near) } else { (near, free) };
             aimed(p.eval(u, v), rng.direction(), 3.0 * radius)
         })
@@ -487,7 +487,7 @@ fn collapsed_rays(patches: &[BezierPatch], n: usize, rng: &mut SplitMix64) -> Ve
 fn curve_rays(p: &BezierPatch, n: usize, rng: &mut SplitMix64) -> Vec<Ray> {
     (0..n)
         .map(|_| {
-            let s = rng.unit();
+            let s = rng.uniform();
             let (_, du, _) = p.derivatives(s, 0.5);
             let across = du.any_orthonormal_vector();
             let tilt = rng.range(-FRAC_PI_2, FRAC_PI_2) * 0.5;
