@@ -45,7 +45,7 @@ use search::{SearchHit, search};
 use crate::geom::Ray;
 use crate::kernel::{KernelStats, PatchHit};
 
-/// The pushed nets and the search nodes of a fast-path search.
+/// The net slots and the search nodes of a fast-path search.
 type RegisterScratch<N> = (Vec<N>, Vec<search::Node<f32>>);
 
 thread_local! {
@@ -128,13 +128,13 @@ fn run(
 #[inline(always)]
 fn run_register<N: RegisterNet>(
     net: N,
-    (pushed, nodes): &mut RegisterScratch<N>,
+    (slots, nodes): &mut RegisterScratch<N>,
     root: GBox<f32>,
     ray: &GRay<f32>,
     cfg: &SubdivisionConfig,
     any_hit: bool,
     stats: &mut KernelStats,
 ) -> Option<SearchHit<f32>> {
-    let mut nets = RegisterStack::new(net, pushed);
+    let mut nets = RegisterStack::new(net, slots);
     search(&mut nets, nodes, root, ray, false, cfg, any_hit, stats)
 }

@@ -1,7 +1,8 @@
 //! The net stack of the fixed-size SIMD fast paths ([`super::bicubic`], [`super::bilinear`]):
 //! the current net lives by value (in registers where the compiler can keep it), a split
-//! writes the lower child over it and the upper child beside it, and only the farther hit
-//! child is copied to the stack (the "nearer side first" order of Dammertz §2.5).
+//! writes the lower child over it and the upper child into the next free stack slot, so
+//! that pushing the upper child (the "nearer side first" order of Dammertz §2.5) costs no
+//! copy and pushing the lower one costs a swap.
 
 use super::float::GBox;
 use super::heuristics::Corners;
@@ -18,22 +19,25 @@ pub trait RegisterNet: Copy {
     fn corners(&self) -> Corners<f32>;
 }
 
-/// The current net by value, the pending upper child, and the pushed nets.
+/// The current net by value; the pushed nets in `slots[..top]` and the pending upper child
+/// of the last split in `slots[top]`, so that pushing it is no copy.
 pub struct RegisterStack<'a, N> {
     pub cur: N,
-    pub upper: N,
-    pub pushed: &'a mut Vec<N>,
+    pub slots: &'a mut Vec<N>,
+    pub top: usize,
 }
 
 impl<'a, N: RegisterNet> RegisterStack<'a, N> {
-    /// A stack holding only `root`; `pushed` is reused scratch (cleared here).
+    /// A stack holding only `root`; `slots` is reused scratch.
     #[inline(always)]
-    pub fn new(root: N, pushed: &'a mut Vec<N>) -> Self {
-        pushed.clear();
+    pub fn new(root: N, slots: &'a mut Vec<N>) -> Self {
+        if slots.is_empty() {
+            slots.push(root);
+        }
         RegisterStack {
             cur: root,
-            upper: root,
-            pushed,
+            slots,
+            top: 0,
         }
     }
 }
@@ -46,31 +50,34 @@ impl<N: RegisterNet> NetStack<f32> for RegisterStack<'_, N> {
 
     #[inline(always)]
     fn split(&mut self, dir: Split) -> [GBox<f32>; 2] {
-        self.upper = self.cur.split_in_place(dir);
-        [self.cur.bounds(), self.upper.bounds()]
+        let upper = &mut self.slots[self.top];
+        *upper = self.cur.split_in_place(dir);
+        [self.cur.bounds(), upper.bounds()]
     }
 
     #[inline(always)]
     fn push_far(&mut self, far_is_lower: bool) {
         if far_is_lower {
-            self.pushed.push(self.cur);
-            self.cur = self.upper;
-        } else {
-            self.pushed.push(self.upper);
+            std::mem::swap(&mut self.cur, &mut self.slots[self.top]);
+        }
+        self.top += 1;
+        if self.slots.len() == self.top {
+            self.slots.push(self.cur);
         }
     }
 
     #[inline(always)]
     fn keep(&mut self, lower: bool) {
         if !lower {
-            self.cur = self.upper;
+            self.cur = self.slots[self.top];
         }
     }
 
     #[inline(always)]
     fn pop(&mut self) {
-        if let Some(n) = self.pushed.pop() {
-            self.cur = n;
+        if let Some(top) = self.top.checked_sub(1) {
+            self.top = top;
+            self.cur = self.slots[top];
         }
     }
 }
