@@ -13,8 +13,8 @@ use glam::{Mat4, Vec4};
 use super::float::GBox;
 use super::heuristics::Corners;
 use super::param::Split;
-use super::search::NetStack;
-use crate::geom::{Aabb, BezierPatch};
+use super::register::RegisterNet;
+use crate::geom::BezierPatch;
 
 /// One coordinate of the net: `rows[j]` holds the points (0..4, j), or when the net is
 /// transposed `rows[i]` holds the points (i, 0..4).
@@ -72,17 +72,27 @@ impl Net {
         }
     }
 
+    /// Point (i, j) of the net.
+    pub fn point(&self, i: usize, j: usize) -> [f32; 3] {
+        let (r, l) = if self.transposed { (i, j) } else { (j, i) };
+        [self.xyz[0][r][l], self.xyz[1][r][l], self.xyz[2][r][l]]
+    }
+}
+
+impl RegisterNet for Net {
     #[inline(always)]
-    pub fn bounds(&self) -> Aabb {
+    fn bounds(&self) -> GBox<f32> {
         let (x0, x1) = block_range(&self.xyz[0]);
         let (y0, y1) = block_range(&self.xyz[1]);
         let (z0, z1) = block_range(&self.xyz[2]);
-        Aabb::new(glam::Vec3::new(x0, y0, z0), glam::Vec3::new(x1, y1, z1))
+        GBox {
+            min: [x0, y0, z0],
+            max: [x1, y1, z1],
+        }
     }
 
-    /// Splits at 1/2: `self` becomes the lower half, the upper half is returned.
     #[inline(always)]
-    pub fn split_in_place(&mut self, dir: Split) -> Net {
+    fn split_in_place(&mut self, dir: Split) -> Net {
         // The registers run across the split direction: split them as they are.
         // Otherwise transpose first, which leaves both children transposed.
         let across_registers = (dir == Split::V) != self.transposed;
@@ -98,12 +108,6 @@ impl Net {
             xyz: upper,
             transposed: self.transposed,
         }
-    }
-
-    /// Point (i, j) of the net.
-    pub fn point(&self, i: usize, j: usize) -> [f32; 3] {
-        let (r, l) = if self.transposed { (i, j) } else { (j, i) };
-        [self.xyz[0][r][l], self.xyz[1][r][l], self.xyz[2][r][l]]
     }
 
     #[inline(always)]
@@ -122,53 +126,6 @@ impl Net {
             p00: [x[0].x, y[0].x, z[0].x],
             pn0,
             p0m,
-        }
-    }
-}
-
-/// The current net by value, the pending upper child, and the pushed nets.
-pub struct BicubicStack<'a> {
-    pub cur: Net,
-    pub upper: Net,
-    pub pushed: &'a mut Vec<Net>,
-}
-
-impl NetStack<f32> for BicubicStack<'_> {
-    #[inline(always)]
-    fn corners(&self) -> Corners<f32> {
-        self.cur.corners()
-    }
-
-    #[inline(always)]
-    fn split(&mut self, dir: Split) -> [GBox<f32>; 2] {
-        self.upper = self.cur.split_in_place(dir);
-        [
-            GBox::from_aabb(self.cur.bounds()),
-            GBox::from_aabb(self.upper.bounds()),
-        ]
-    }
-
-    #[inline(always)]
-    fn push_far(&mut self, far_is_lower: bool) {
-        if far_is_lower {
-            self.pushed.push(self.cur);
-            self.cur = self.upper;
-        } else {
-            self.pushed.push(self.upper);
-        }
-    }
-
-    #[inline(always)]
-    fn keep(&mut self, lower: bool) {
-        if !lower {
-            self.cur = self.upper;
-        }
-    }
-
-    #[inline(always)]
-    fn pop(&mut self) {
-        if let Some(n) = self.pushed.pop() {
-            self.cur = n;
         }
     }
 }
@@ -242,8 +199,8 @@ mod tests {
     #[test]
     fn bounds_are_the_control_box() {
         let p = patch();
-        let b = Net::from_patch(&p).bounds();
-        let want: Aabb = p.euclidean_points().map(|q| q.as_vec3()).collect();
+        let b = Net::from_patch(&p).bounds().to_aabb();
+        let want: crate::geom::Aabb = p.euclidean_points().map(|q| q.as_vec3()).collect();
         assert_eq!(b, want);
     }
 

@@ -4,7 +4,8 @@
 //! reports `t` at the box entry and (u, v) at the centre of the box's parameter cell.
 //!
 //! - [`search`]: the stack-based search, once for every net storage and precision.
-//! - [`bicubic`]: the SIMD fast path for bicubic integral patches.
+//! - [`bicubic`], [`bilinear`]: the SIMD fast paths for bicubic and bilinear integral
+//!   patches, on the shared [`register`] net stack.
 //! - [`general`]: any degree up to 15, rational patches (homogeneous nets, §2.7.2).
 //! - [`reference`]: the same algorithm in `f64`, the accuracy reference (§2.3.4).
 //! - [`heuristics`], [`config`], [`param`], [`float`]: split direction, settings,
@@ -16,6 +17,7 @@
 //! bounded by the parameter cell ([`param`]).
 
 pub mod bicubic;
+pub mod bilinear;
 pub mod config;
 pub mod float;
 pub mod general;
@@ -23,6 +25,7 @@ pub mod heuristics;
 pub mod param;
 pub mod prepared;
 pub mod reference;
+pub mod register;
 pub mod search;
 
 use std::cell::RefCell;
@@ -31,18 +34,26 @@ pub use config::{DEFAULT_END_ULPS, DEFAULT_RATIONAL_DIST, SplitHeuristic, Subdiv
 pub use prepared::PreparedPatch;
 pub use reference::{PatchHit64, intersect_f64};
 
-use bicubic::{BicubicStack, Net};
+use bicubic::Net;
+use bilinear::BilinearNet;
 use float::{GBox, GRay};
 use general::{GeneralStack, Scratch};
 use prepared::Prepared;
+use register::{RegisterNet, RegisterStack};
 use search::{SearchHit, search};
 
 use crate::geom::Ray;
 use crate::kernel::{KernelStats, PatchHit};
 
+/// The net slots and the search nodes of a fast-path search.
+type RegisterScratch<N> = (Vec<N>, Vec<search::Node<f32>>);
+
 thread_local! {
     /// Per-thread buffers of the bicubic path: the pushed nets and the search nodes.
-    static BICUBIC_SCRATCH: RefCell<(Vec<Net>, Vec<search::Node<f32>>)> =
+    static BICUBIC_SCRATCH: RefCell<RegisterScratch<Net>> =
+        const { RefCell::new((Vec::new(), Vec::new())) };
+    /// Per-thread buffers of the bilinear path.
+    static BILINEAR_SCRATCH: RefCell<RegisterScratch<BilinearNet>> =
         const { RefCell::new((Vec::new(), Vec::new())) };
     /// Per-thread buffers of the general path.
     static GENERAL_SCRATCH: RefCell<Scratch<f32>> = RefCell::new(Scratch::default());
@@ -91,14 +102,11 @@ fn run(
     );
     let root = GBox::from_aabb(patch.bounds);
     match &patch.data {
-        Prepared::Bicubic(net) => BICUBIC_SCRATCH.with_borrow_mut(|(pushed, nodes)| {
-            pushed.clear();
-            let mut nets = BicubicStack {
-                cur: *net,
-                upper: *net,
-                pushed,
-            };
-            search(&mut nets, nodes, root, &gray, false, cfg, any_hit, stats)
+        Prepared::Bicubic(net) => BICUBIC_SCRATCH.with_borrow_mut(|scratch| {
+            run_register(*net, scratch, root, &gray, cfg, any_hit, stats)
+        }),
+        Prepared::Bilinear(net) => BILINEAR_SCRATCH.with_borrow_mut(|scratch| {
+            run_register(*net, scratch, root, &gray, cfg, any_hit, stats)
         }),
         Prepared::General { net, shape } => GENERAL_SCRATCH.with_borrow_mut(|s| {
             let mut nets = GeneralStack::new(&mut s.nets, net, *shape);
@@ -114,4 +122,19 @@ fn run(
             )
         }),
     }
+}
+
+/// A search on one of the fixed-size SIMD paths (integral nets only).
+#[inline(always)]
+fn run_register<N: RegisterNet>(
+    net: N,
+    (slots, nodes): &mut RegisterScratch<N>,
+    root: GBox<f32>,
+    ray: &GRay<f32>,
+    cfg: &SubdivisionConfig,
+    any_hit: bool,
+    stats: &mut KernelStats,
+) -> Option<SearchHit<f32>> {
+    let mut nets = RegisterStack::new(net, slots);
+    search(&mut nets, nodes, root, ray, false, cfg, any_hit, stats)
 }

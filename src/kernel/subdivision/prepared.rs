@@ -1,14 +1,17 @@
-//! The per-patch data of the `f32` kernel, built once per patch: the bicubic fast path's
-//! structure-of-arrays net, or the general path's homogeneous net.
+//! The per-patch data of the `f32` kernel, built once per patch: the bicubic or bilinear
+//! fast path's structure-of-arrays net, or the general path's homogeneous net.
 
 use super::bicubic::Net;
+use super::bilinear::BilinearNet;
 use super::general::{NetShape, net_box};
+use super::register::RegisterNet;
 use crate::geom::{Aabb, BezierPatch};
 
 /// Which path a patch takes (Dammertz §2.7.1: the choice is made once, before any ray).
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) enum Prepared {
     Bicubic(Net),
+    Bilinear(BilinearNet),
     General { net: Vec<[f32; 4]>, shape: NetShape },
 }
 
@@ -24,10 +27,22 @@ impl PreparedPatch {
         if patch.is_plain_bicubic() {
             let net = Net::from_patch(patch);
             return PreparedPatch {
-                bounds: net.bounds(),
+                bounds: net.bounds().to_aabb(),
                 data: Prepared::Bicubic(net),
             };
         }
+        if let Some(net) = BilinearNet::from_patch(patch) {
+            return PreparedPatch {
+                bounds: net.bounds().to_aabb(),
+                data: Prepared::Bilinear(net),
+            };
+        }
+        PreparedPatch::general(patch)
+    }
+
+    /// The general path for any patch (Dammertz §2.7.2), also the reference the fast paths
+    /// are tested against.
+    pub(crate) fn general(patch: &BezierPatch) -> PreparedPatch {
         let shape = NetShape {
             nu: patch.degree_u() + 1,
             nv: patch.degree_v() + 1,
