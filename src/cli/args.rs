@@ -191,12 +191,8 @@ pub struct RenderArgs {
     /// Ulps by which secondary ray origins are moved off the hit box (Dammertz §2.4.2).
     #[arg(long, default_value_t = crate::kernel::secondary::DEFAULT_ULPS)]
     pub ulps: u32,
-    /// Override the camera's image width.
-    #[arg(long)]
-    pub width: Option<u32>,
-    /// Override the camera's image height.
-    #[arg(long)]
-    pub height: Option<u32>,
+    #[command(flatten)]
+    pub size: ImageSizeArgs,
     /// Worker threads (default: all cores). The image is identical for any count.
     #[arg(long)]
     pub threads: Option<usize>,
@@ -322,12 +318,8 @@ pub struct CompareArgs {
     /// Directory for the images, heat maps and the table (created if missing).
     #[arg(long, default_value = "compare-out")]
     pub out_dir: PathBuf,
-    /// Override the camera's image width.
-    #[arg(long)]
-    pub width: Option<u32>,
-    /// Override the camera's image height.
-    #[arg(long)]
-    pub height: Option<u32>,
+    #[command(flatten)]
+    pub size: ImageSizeArgs,
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -359,4 +351,28 @@ pub struct AccuracyArgs {
     /// No progress messages.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// Overrides of the scene camera's image size.
+#[derive(Debug, Args, Clone, Copy)]
+pub struct ImageSizeArgs {
+    /// Override the camera's image width.
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Override the camera's image height.
+    #[arg(long)]
+    pub height: Option<u32>,
+}
+
+impl ImageSizeArgs {
+    /// Applies the overrides to `camera`, refusing a zero size.
+    pub fn apply(&self, camera: &mut crate::scene::Camera) -> anyhow::Result<()> {
+        anyhow::ensure!(
+            self.width != Some(0) && self.height != Some(0),
+            "--width and --height must be at least 1"
+        );
+        camera.width = self.width.unwrap_or(camera.width);
+        camera.height = self.height.unwrap_or(camera.height);
+        Ok(())
+    }
 }

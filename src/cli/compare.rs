@@ -62,16 +62,7 @@ fn render(scene: &Scene, quiet: bool, label: &str, pool: &rayon::ThreadPool) -> 
 pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     let pool = thread_pool(args.threads)?;
     let mut scene = load_scene(&args.scene)?;
-    if let Some(w) = args.width {
-        scene.camera.width = w;
-    }
-    if let Some(h) = args.height {
-        scene.camera.height = h;
-    }
-    anyhow::ensure!(
-        scene.camera.width > 0 && scene.camera.height > 0,
-        "--width and --height must be at least 1"
-    );
+    args.size.apply(&mut scene.camera)?;
     std::fs::create_dir_all(&args.out_dir)
         .with_context(|| format!("creating {}", args.out_dir.display()))?;
     if !args.quiet {

@@ -4,7 +4,6 @@ use std::io::Write;
 use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::bail;
 use serde::Serialize;
 
 use crate::cli::args::{Aov, RenderArgs};
@@ -35,9 +34,6 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         )
         .into());
     }
-    if args.width == Some(0) || args.height == Some(0) {
-        bail!("--width and --height must be at least 1");
-    }
     if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty()) {
         if !dir.is_dir() {
             return Err(LoadError::invalid(
@@ -50,12 +46,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     let pool = thread_pool(args.threads)?;
     let mut prepared = prepare(&args.scene, &args.kernel)?;
     let scene = &mut prepared.scene;
-    if let Some(w) = args.width {
-        scene.camera.width = w;
-    }
-    if let Some(h) = args.height {
-        scene.camera.height = h;
-    }
+    args.size.apply(&mut scene.camera)?;
     let plan = EffectPlan::for_scene(scene);
     eprintln!("{plan}");
     let integrator = Integrator {
