@@ -122,27 +122,8 @@ impl SceneGeometry {
 
     /// A hash of the geometry the BVH indexes: degrees and control points in file order,
     /// then triangle corners. A BVH file records it so that a stale file is refused.
-    pub fn hash_scene(scene: &Scene) -> u64 {
-        let mut h = GeometryHasher::new();
-        let (patches, _) = collect_patches(scene);
-        let triangles = collect_triangles(scene);
-        h.write_u64(triangles.corners.len() as u64);
-        for c in triangles.corners.iter().flatten() {
-            for x in c.to_array() {
-                h.write_f64(x as f64);
-            }
-        }
-        h.write_u64(patches.len() as u64);
-        for p in &patches {
-            h.write_u64(p.degree_u() as u64);
-            h.write_u64(p.degree_v() as u64);
-            for q in p.homogeneous_points() {
-                for c in q.to_array() {
-                    h.write_f64(c);
-                }
-            }
-        }
-        h.finish()
+    pub fn geometry_hash(&self) -> u64 {
+        hash_geometry(&self.originals, &self.triangles)
     }
 
     pub fn bvh(&self) -> &Bvh {
@@ -360,10 +341,10 @@ impl SceneGeometry {
         use crate::scene::LoadError;
         let file = std::fs::File::open(path).map_err(|e| LoadError::io(path, e))?;
         let mut reader = std::io::BufReader::new(file);
-        let bvh = Bvh::read(&mut reader, Self::hash_scene(scene))
-            .map_err(|e| LoadError::invalid(path, e.to_string()))?;
         let (originals, ids) = collect_patches(scene);
         let triangles = collect_triangles(scene);
+        let bvh = Bvh::read(&mut reader, hash_geometry(&originals, &triangles))
+            .map_err(|e| LoadError::invalid(path, e.to_string()))?;
         if bvh.prim_count() != originals.len() + triangles.corners.len() {
             return Err(LoadError::invalid(
                 path,
@@ -374,14 +355,33 @@ impl SceneGeometry {
     }
 
     /// Writes the BVH with the scene's geometry hash, atomically.
-    pub fn save_bvh(
-        &self,
-        scene: &Scene,
-        path: &std::path::Path,
-    ) -> Result<(), crate::scene::LoadError> {
-        let hash = Self::hash_scene(scene);
+    pub fn save_bvh(&self, path: &std::path::Path) -> Result<(), crate::scene::LoadError> {
+        let hash = self.geometry_hash();
         crate::scene::write::write_atomic(path, |w| self.bvh.write(w, hash))
     }
+}
+
+/// The hash a BVH file records: triangle corners, then degrees and control points in file
+/// order, so that a file built for other geometry is refused as stale.
+fn hash_geometry(patches: &[BezierPatch], triangles: &Triangles) -> u64 {
+    let mut h = GeometryHasher::new();
+    h.write_u64(triangles.corners.len() as u64);
+    for c in triangles.corners.iter().flatten() {
+        for x in c.to_array() {
+            h.write_f64(x as f64);
+        }
+    }
+    h.write_u64(patches.len() as u64);
+    for p in patches {
+        h.write_u64(p.degree_u() as u64);
+        h.write_u64(p.degree_v() as u64);
+        for q in p.homogeneous_points() {
+            for c in q.to_array() {
+                h.write_f64(c);
+            }
+        }
+    }
+    h.finish()
 }
 
 /// All mesh triangles of the scene in object order, rounded to `f32`.

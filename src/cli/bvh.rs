@@ -12,7 +12,7 @@ pub fn run(args: BvhArgs) -> anyhow::Result<ExitCode> {
     let start = Instant::now();
     let geometry = SceneGeometry::build(&scene);
     let build = start.elapsed().as_secs_f64();
-    geometry.save_bvh(&scene, &args.output)?;
+    geometry.save_bvh(&args.output)?;
     eprintln!(
         "wrote {}: {} patches, {} nodes, built in {:.3} s",
         args.output.display(),
