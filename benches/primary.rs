@@ -9,27 +9,15 @@
 use std::path::Path;
 use std::time::Instant;
 
-use glam::DVec3;
 use patchtrace::accel::scene::{Precision, QueryStats, SceneGeometry};
 use patchtrace::geom::Ray;
 use patchtrace::kernel::subdivision::SubdivisionConfig;
 use patchtrace::render::camera::CameraRays;
-use patchtrace::scene::{Camera, Geometry, Object, Scene, Surface, bpt::read_bpt};
+use patchtrace::scene::{Geometry, Object, Scene, Surface, bpt::read_bpt, load_scene};
 use patchtrace::tessellate::{TessellationMode, tessellate_scene};
 
 const RUNS: usize = 5;
 const SIZE: u32 = 512;
-
-fn camera() -> Camera {
-    Camera {
-        eye: DVec3::new(0.0, -8.0, 4.5),
-        look_at: DVec3::new(0.0, 0.0, 1.2),
-        up: DVec3::Z,
-        fov_y: 40.0,
-        width: SIZE,
-        height: SIZE,
-    }
-}
 
 /// Median seconds to trace `rays` through `geometry`, and the number of hits.
 fn time(geometry: &SceneGeometry, rays: &[Ray]) -> (f64, usize) {
@@ -52,14 +40,19 @@ fn time(geometry: &SceneGeometry, rays: &[Ray]) -> (f64, usize) {
 }
 
 fn main() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("testdata/teapot.bpt");
-    let patches = read_bpt(&path).expect("testdata/teapot.bpt");
+    let testdata = Path::new(env!("CARGO_MANIFEST_DIR")).join("testdata");
+    let patches = read_bpt(&testdata.join("teapot.bpt")).expect("testdata/teapot.bpt");
     let mut scene = Scene::framing(vec![Object {
         name: "teapot".into(),
         material: 0,
         geometry: Geometry::Surfaces(patches.into_iter().map(Surface::bezier).collect()),
     }]);
-    scene.camera = camera();
+    // The sample scene's camera at SIZE², looking at the bare teapot (no floor).
+    scene.camera = load_scene(&testdata.join("teapot.ron"))
+        .expect("testdata/teapot.ron")
+        .camera;
+    scene.camera.width = SIZE;
+    scene.camera.height = SIZE;
     let cam = CameraRays::new(&scene.camera);
     let rays: Vec<Ray> = (0..SIZE)
         .flat_map(|y| (0..SIZE).map(move |x| (x, y)))
