@@ -2,23 +2,15 @@
 
 mod common;
 
-use common::{run, stderr, stdout, testdata};
+use common::{render, run, stderr, stdout, testdata};
 
 fn stats(scene: &str, extra: &[&str]) -> serde_json::Value {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("x.png");
     let scene = testdata(scene);
-    let mut args = vec![
-        "render",
-        scene.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--stats",
-        "-q",
-    ];
-    args.extend_from_slice(&["--width", "24", "--height", "24"]);
+    let mut args = vec!["--stats"];
     args.extend_from_slice(extra);
-    let o = run(&args);
+    let o = render(&scene, &out, (24, 24), &args);
     assert!(o.status.success(), "{}", stderr(&o));
     serde_json::from_str(&stdout(&o)).expect("stats JSON")
 }
@@ -63,18 +55,7 @@ fn a_scene_without_lights_traces_no_shadow_rays() {
     );
     std::fs::write(&scene, src).unwrap();
     let out = dir.path().join("x.png");
-    let o = run(&[
-        "render",
-        scene.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--stats",
-        "-q",
-        "--width",
-        "16",
-        "--height",
-        "16",
-    ]);
+    let o = render(&scene, &out, (16, 16), &["--stats"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let s: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     assert_eq!(s["plan"]["shadows"], false);
@@ -89,19 +70,7 @@ fn image_bytes_do_not_depend_on_the_thread_count() {
     let mut images = Vec::new();
     for threads in ["1", "2", "3"] {
         let out = dir.path().join(format!("t{threads}.png"));
-        let o = run(&[
-            "render",
-            scene.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-            "-q",
-            "--width",
-            "40",
-            "--height",
-            "30",
-            "--threads",
-            threads,
-        ]);
+        let o = render(&scene, &out, (40, 30), &["--threads", threads]);
         assert!(o.status.success(), "{}", stderr(&o));
         images.push(std::fs::read(&out).unwrap());
     }
@@ -118,19 +87,7 @@ fn a_saved_bvh_renders_the_same_bytes_and_a_stale_one_is_refused() {
     assert!(o.status.success(), "{}", stderr(&o));
     let render = |extra: &[&str], name: &str| {
         let out = dir.path().join(name);
-        let mut args = vec![
-            "render",
-            scene.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-            "-q",
-            "--width",
-            "32",
-            "--height",
-            "32",
-        ];
-        args.extend_from_slice(extra);
-        let o = run(&args);
+        let o = render(&scene, &out, (32, 32), extra);
         assert!(o.status.success(), "{}", stderr(&o));
         std::fs::read(out).unwrap()
     };
@@ -173,17 +130,7 @@ fn exr_output_is_linear_rgba_with_coverage_alpha() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("x.exr");
     let scene = testdata("teapot.ron");
-    let o = run(&[
-        "render",
-        scene.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "-q",
-        "--width",
-        "20",
-        "--height",
-        "20",
-    ]);
+    let o = render(&scene, &out, (20, 20), &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     use exr::prelude::*;
     let img = read_first_rgba_layer_from_file(
@@ -205,20 +152,7 @@ fn effort_aov_counts_every_split_of_the_render() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("e.png");
     let scene = testdata("teapot.ron");
-    let o = run(&[
-        "render",
-        scene.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "-q",
-        "--width",
-        "24",
-        "--height",
-        "24",
-        "--aov",
-        "effort",
-        "--stats",
-    ]);
+    let o = render(&scene, &out, (24, 24), &["--aov", "effort", "--stats"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let s: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     let total_splits = s["rays"]["splits_per_ray"]["mean"].as_f64().unwrap()

@@ -27,3 +27,21 @@ pub fn stderr(o: &Output) -> String {
 pub fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
+
+/// `patchtrace render SCENE -o OUT -q --width W --height H EXTRA...`.
+pub fn render(scene: &Path, out: &Path, (width, height): (u32, u32), extra: &[&str]) -> Output {
+    let (w, h) = (width.to_string(), height.to_string());
+    let mut args = vec![
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "-q",
+        "--width",
+        &w,
+        "--height",
+        &h,
+    ];
+    args.extend_from_slice(extra);
+    run(&args)
+}
