@@ -319,11 +319,17 @@ impl SceneGeometry {
 }
 
 /// All Bézier patches of the scene in contract order, with their (object, patch) ids.
+/// Patches collapsed to a curve or a point are left out: they have no area, so no ray hits
+/// them exactly, while rounding would let the `f32` kernel report hits on them whose
+/// secondary rays, lacking a normal to leave along, re-hit the same curve (issue 7).
 fn collect_patches(scene: &Scene) -> (Vec<BezierPatch>, Vec<(u32, u32)>) {
     let mut patches = Vec::new();
     let mut ids = Vec::new();
     for (o, object) in scene.objects.iter().enumerate() {
         for (k, p) in object.bezier_patches().into_iter().enumerate() {
+            if p.has_zero_area() {
+                continue;
+            }
             patches.push(p);
             ids.push((o as u32, k as u32));
         }

@@ -177,6 +177,19 @@ impl BezierPatch {
         self.points.iter().any(|p| p.w != 1.0)
     }
 
+    /// True when the surface is a curve or a point, so it has no area: every row of the net
+    /// (fixed v) repeats one homogeneous point, or every column does, and the surface then
+    /// does not depend on u (or v). Exact comparison: a nearly degenerate patch still has
+    /// area and is left to the kernel.
+    pub fn has_zero_area(&self) -> bool {
+        let (nu, nv) = (self.degree_u + 1, self.degree_v + 1);
+        let rows_repeat =
+            (0..nv).all(|j| (1..nu).all(|i| self.homogeneous(i, j) == self.homogeneous(0, j)));
+        let columns_repeat =
+            (0..nu).all(|i| (1..nv).all(|j| self.homogeneous(i, j) == self.homogeneous(i, 0)));
+        rows_repeat || columns_repeat
+    }
+
     /// True for the common bicubic non-rational case that has a fixed-size fast path.
     pub fn is_plain_bicubic(&self) -> bool {
         self.degree_u == 3 && self.degree_v == 3 && !self.is_rational()

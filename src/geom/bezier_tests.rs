@@ -226,3 +226,37 @@ fn invalid_patches_are_refused() {
         })
     );
 }
+
+#[test]
+fn zero_area_means_the_surface_ignores_a_parameter() {
+    // Independent check: the cross product of the exact derivatives vanishes everywhere
+    // exactly when the patch is reported as having no area.
+    let curve = |transposed: bool| {
+        let pts: Vec<DVec3> = (0..12)
+            .map(|k| {
+                let (i, j) = (k % 4, k / 4);
+                let s = if transposed {
+                    j as f64 / 2.0
+                } else {
+                    i as f64 / 3.0
+                };
+                DVec3::new(2.0 * s - 1.0, (3.0 * s).sin(), 0.3 * s * s)
+            })
+            .collect();
+        BezierPatch::from_points(3, 2, &pts).unwrap()
+    };
+    let point = BezierPatch::from_points(1, 1, &[DVec3::ONE; 4]).unwrap();
+    for p in [curve(false), curve(true), point] {
+        assert!(p.has_zero_area());
+        for (u, v) in [(0.2, 0.7), (0.5, 0.5), (0.9, 0.1)] {
+            let (_, su, sv) = p.derivatives(u, v);
+            assert!(su.cross(sv).length() < 1e-12);
+        }
+    }
+    // The teapot's patches with one collapsed edge keep their area.
+    for p in teapot() {
+        assert!(!p.has_zero_area());
+        let (_, su, sv) = p.derivatives(0.5, 0.5);
+        assert!(su.cross(sv).length() > 1e-6);
+    }
+}

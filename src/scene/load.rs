@@ -81,8 +81,9 @@ pub const MIN_OBJECT_EXTENT: f64 = 1.0 / (1u64 << 60) as f64;
 
 /// The renderer rounds geometry to `f32` once; a coordinate beyond its range would become
 /// infinite there, and an object smaller than [`MIN_OBJECT_EXTENT`] would shade in the
-/// subnormal range, so both are refused with the object's name.
-fn check_f32_range(path: &Path, scene: &Scene) -> Result<(), LoadError> {
+/// subnormal range, so both are refused with the object's name. `path` names the scene in
+/// the error.
+pub fn check_f32_range(path: &Path, scene: &Scene) -> Result<(), LoadError> {
     for o in &scene.objects {
         let b = o.bounds();
         if b.is_empty() {

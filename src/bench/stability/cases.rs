@@ -69,6 +69,9 @@ const TINY_HUGE_RATIO: f64 = 1e6;
 const SUBNORMAL_SCALE: f64 = 1e-40;
 /// A scale just above the normal range: boxes of sub-patches shrink into subnormals.
 const NEAR_SUBNORMAL_SCALE: f64 = 1e-35;
+/// The smallest scale the loader accepts, rounded to a power of ten: the teapot (about 6
+/// across) stays above `scene::load::MIN_OBJECT_EXTENT` (2^-60 ≈ 8.7e-19).
+const SMALLEST_ACCEPTED_SCALE: f64 = 1e-18;
 
 /// Every case of the suite, in report order.
 pub fn all_cases(size: SuiteSize, seed: u64) -> Vec<Case> {
@@ -152,6 +155,15 @@ pub fn all_cases(size: SuiteSize, seed: u64) -> Vec<Case> {
         "tiny beside huge (1e6)",
         &pair,
         random_rays(&pair, n, &mut rng),
+    ));
+    let p = transformed(
+        &teapot,
+        DAffine3::from_scale(DVec3::splat(SMALLEST_ACCEPTED_SCALE)),
+    );
+    cases.push(case(
+        &format!("teapot x{SMALLEST_ACCEPTED_SCALE:e} (smallest accepted)"),
+        &p,
+        random_rays(&p, n, &mut rng),
     ));
     for s in [NEAR_SUBNORMAL_SCALE, SUBNORMAL_SCALE] {
         let p = transformed(&teapot, DAffine3::from_scale(DVec3::splat(s)));

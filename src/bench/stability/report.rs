@@ -6,7 +6,7 @@ use std::fmt::Write;
 use super::CaseResult;
 
 /// Column headers, shared by both formats.
-const HEADERS: [&str; 16] = [
+const HEADERS: [&str; 17] = [
     "case",
     "kernel",
     "rays",
@@ -20,6 +20,7 @@ const HEADERS: [&str; 16] = [
     "non-finite normals",
     "dist median (ulps)",
     "dist max (ulps)",
+    "dist across median (ulps)",
     "splits mean",
     "splits max (per patch)",
     "NaN px",
@@ -50,6 +51,7 @@ fn cells(r: &CaseResult) -> Vec<String> {
         f.non_finite_normals.to_string(),
         format!("{:.2}", f.distance_median),
         format!("{:.3e}", f.distance_max),
+        format!("{:.2}", f.normal_distance_median),
         splits_mean,
         splits_max,
         format!("{}/{}", f.nan_pixels, f.pixels),
@@ -58,7 +60,9 @@ fn cells(r: &CaseResult) -> Vec<String> {
 
 fn failures(r: &CaseResult) -> String {
     let fails = r.figures.failures();
-    if fails.is_empty() {
+    if let Some(message) = &r.figures.refused {
+        format!("refused: {message}")
+    } else if fails.is_empty() {
         "ok".to_string()
     } else {
         fails
@@ -90,7 +94,8 @@ pub fn csv(results: &[CaseResult]) -> String {
     let _ = writeln!(
         out,
         "case,kernel,rays,ref_hits,hits,holes,false_hits,within_box,secondary,self_hits,\
-         non_finite_normals,dist_median_ulps,dist_max_ulps,splits_mean,splits_max,\
+         non_finite_normals,dist_median_ulps,dist_max_ulps,dist_across_median_ulps,\
+         splits_mean,splits_max,\
          splits_max_per_patch,nan_pixels,pixels,fails"
     );
     for r in results {
@@ -103,11 +108,13 @@ pub fn csv(results: &[CaseResult]) -> String {
             ),
             None => Default::default(),
         };
-        let fails = r.figures.failures();
-        let fails: Vec<String> = fails.iter().map(|c| c.to_string()).collect();
+        let fails = match &r.figures.refused {
+            Some(_) => vec!["refused".to_string()],
+            None => r.figures.failures().iter().map(|c| c.to_string()).collect(),
+        };
         let _ = writeln!(
             out,
-            "\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\"",
+            "\"{}\",{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},\"{}\"",
             r.case.replace('"', "\"\""),
             r.path.name(),
             f.rays,
@@ -121,6 +128,7 @@ pub fn csv(results: &[CaseResult]) -> String {
             f.non_finite_normals,
             f.distance_median,
             f.distance_max,
+            f.normal_distance_median,
             mean,
             max,
             per,
