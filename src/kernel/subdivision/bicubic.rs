@@ -6,14 +6,14 @@
 //! along the rows instead transposes each block once and leaves the children transposed
 //! (the net records its orientation), so alternating split directions cost one transpose
 //! per split rather than three. The box is a lane-wise min/max over the rows followed by
-//! a horizontal reduction; it does not depend on the orientation.
+//! one transposed horizontal reduction for all three coordinates
+//! ([`super::register::reduce3`]); it does not depend on the orientation.
 
-use glam::{Mat4, Vec4};
+use glam::{Mat4, Vec3A, Vec4};
 
-use super::float::GBox;
 use super::heuristics::Corners;
 use super::param::Split;
-use super::register::RegisterNet;
+use super::register::{RegisterNet, reduce3};
 use crate::geom::BezierPatch;
 
 /// One coordinate of the net: `rows[j]` holds the points (0..4, j), or when the net is
@@ -49,11 +49,12 @@ fn transpose(b: Block) -> Block {
     [m.x_axis, m.y_axis, m.z_axis, m.w_axis]
 }
 
+/// Lane-wise minimum and maximum over the four registers of a block.
 #[inline(always)]
-fn block_range(b: &Block) -> (f32, f32) {
+fn block_range(b: &Block) -> (Vec4, Vec4) {
     let lo = b[0].min(b[1]).min(b[2].min(b[3]));
     let hi = b[0].max(b[1]).max(b[2].max(b[3]));
-    (lo.min_element(), hi.max_element())
+    (lo, hi)
 }
 
 impl Net {
@@ -81,14 +82,14 @@ impl Net {
 
 impl RegisterNet for Net {
     #[inline(always)]
-    fn bounds(&self) -> GBox<f32> {
-        let (x0, x1) = block_range(&self.xyz[0]);
-        let (y0, y1) = block_range(&self.xyz[1]);
-        let (z0, z1) = block_range(&self.xyz[2]);
-        GBox {
-            min: [x0, y0, z0],
-            max: [x1, y1, z1],
-        }
+    fn bounds_pair(a: &Net, b: &Net) -> [(Vec3A, Vec3A); 2] {
+        [a, b].map(|n| {
+            let [(x0, x1), (y0, y1), (z0, z1)] = n.xyz.each_ref().map(block_range);
+            (
+                reduce3(x0, y0, z0, Vec4::min),
+                reduce3(x1, y1, z1, Vec4::max),
+            )
+        })
     }
 
     #[inline(always)]

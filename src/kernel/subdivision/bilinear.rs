@@ -3,16 +3,16 @@
 //! The net is structure-of-arrays: one SSE register per coordinate holding the corners
 //! `b(0,0), b(1,0), b(0,1), b(1,1)` in its lanes. A split at 1/2 averages pairs of lanes
 //! (de Casteljau for two points is one average) and blends the averages into the lanes of
-//! the corners they replace; the box is a horizontal min/max per register. The averages are
+//! the corners they replace; the box is one transposed horizontal min/max of the three
+//! registers ([`super::register::reduce3`]). The averages are
 //! the same operations as `general::split_net`'s, so the search is bit-identical to the
 //! general path's on such a patch.
 
-use glam::{BVec4A, Vec4, Vec4Swizzles};
+use glam::{BVec4A, Vec3A, Vec4, Vec4Swizzles};
 
-use super::float::GBox;
 use super::heuristics::Corners;
 use super::param::Split;
-use super::register::RegisterNet;
+use super::register::{RegisterNet, reduce3};
 use crate::geom::BezierPatch;
 
 /// Lanes of the corners a split in u replaces in the lower child: `b(1,0)` and `b(1,1)`.
@@ -62,12 +62,11 @@ impl RegisterNet for BilinearNet {
     }
 
     #[inline(always)]
-    fn bounds(&self) -> GBox<f32> {
-        let [x, y, z] = self.xyz;
-        GBox {
-            min: [x.min_element(), y.min_element(), z.min_element()],
-            max: [x.max_element(), y.max_element(), z.max_element()],
-        }
+    fn bounds_pair(a: &BilinearNet, b: &BilinearNet) -> [(Vec3A, Vec3A); 2] {
+        [a, b].map(|n| {
+            let [x, y, z] = n.xyz;
+            (reduce3(x, y, z, Vec4::min), reduce3(x, y, z, Vec4::max))
+        })
     }
 
     #[inline(always)]

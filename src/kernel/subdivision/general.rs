@@ -9,7 +9,7 @@
 //! the net of stack entry `k`, the current net sits on top, and a split writes its children
 //! into the top slot and the one above it.
 
-use super::float::{GBox, KernelFloat};
+use super::float::{GBox, GRay, KernelFloat};
 use super::heuristics::Corners;
 use super::param::Split;
 use super::search::{NetStack, Node};
@@ -164,14 +164,14 @@ impl<T: KernelFloat> NetStack<T> for GeneralStack<'_, T> {
         }
     }
 
-    fn split(&mut self, dir: Split) -> [GBox<T>; 2] {
+    fn split_test(&mut self, dir: Split, ray: &GRay<T>, tmax: T) -> [(GBox<T>, Option<T>); 2] {
         let n = self.shape.point_count();
         let (lower, upper) = self.nets[self.top * n..(self.top + 2) * n].split_at_mut(n);
         split_net(lower, upper, self.shape, dir);
-        [
-            net_box(lower, self.shape.rational),
-            net_box(upper, self.shape.rational),
-        ]
+        [lower, upper].map(|net| {
+            let b = net_box(net, self.shape.rational);
+            (b, T::slab(&b, ray, tmax).map(|(t, _)| t))
+        })
     }
 
     fn push_far(&mut self, far_is_lower: bool) {

@@ -39,7 +39,7 @@ use bilinear::BilinearNet;
 use float::{GBox, GRay};
 use general::{GeneralStack, Scratch};
 use prepared::Prepared;
-use register::{RegisterNet, RegisterStack};
+use register::search_register;
 use search::{SearchHit, search};
 
 use crate::geom::Ray;
@@ -102,11 +102,11 @@ fn run(
     );
     let root = GBox::from_aabb(patch.bounds);
     match &patch.data {
-        Prepared::Bicubic(net) => BICUBIC_SCRATCH.with_borrow_mut(|scratch| {
-            run_register(*net, scratch, root, &gray, cfg, any_hit, stats)
+        Prepared::Bicubic(net) => BICUBIC_SCRATCH.with_borrow_mut(|(slots, nodes)| {
+            search_register(*net, slots, nodes, root, &gray, cfg, any_hit, stats)
         }),
-        Prepared::Bilinear(net) => BILINEAR_SCRATCH.with_borrow_mut(|scratch| {
-            run_register(*net, scratch, root, &gray, cfg, any_hit, stats)
+        Prepared::Bilinear(net) => BILINEAR_SCRATCH.with_borrow_mut(|(slots, nodes)| {
+            search_register(*net, slots, nodes, root, &gray, cfg, any_hit, stats)
         }),
         Prepared::General { net, shape } => GENERAL_SCRATCH.with_borrow_mut(|s| {
             let mut nets = GeneralStack::new(&mut s.nets, net, *shape);
@@ -122,19 +122,4 @@ fn run(
             )
         }),
     }
-}
-
-/// A search on one of the fixed-size SIMD paths (integral nets only).
-#[inline(always)]
-fn run_register<N: RegisterNet>(
-    net: N,
-    (slots, nodes): &mut RegisterScratch<N>,
-    root: GBox<f32>,
-    ray: &GRay<f32>,
-    cfg: &SubdivisionConfig,
-    any_hit: bool,
-    stats: &mut KernelStats,
-) -> Option<SearchHit<f32>> {
-    let mut nets = RegisterStack::new(net, slots);
-    search(&mut nets, nodes, root, ray, false, cfg, any_hit, stats)
 }

@@ -1,28 +1,62 @@
 //! The net stack of the fixed-size SIMD fast paths ([`super::bicubic`], [`super::bilinear`]):
-//! the current net lives by value (in registers where the compiler can keep it), a split
-//! writes the lower child over it and the upper child into the next free stack slot, so
-//! that pushing the upper child (the "nearer side first" order of Dammertz §2.5) costs no
-//! copy and pushing the lower one costs a swap.
+//! the current net and the pending upper child of a split live by value (in registers where
+//! the compiler can keep them); both children's boxes and slab tests are computed together,
+//! and the farther child (the "nearer side first" order of Dammertz §2.5) is stored to the
+//! next free stack slot, which is the only copy of a net a split costs.
+//!
+//! The search over such a net is compiled three times ([`search_register`]): for AVX-512
+//! (32 vector registers, so the current net and both children fit without spilling), for
+//! AVX2 (three-operand VEX forms, no register copies) and for the baseline SSE2, chosen
+//! once per call by the CPU's features. The source is the same portable code; the
+//! instruction sets only change the encoding and the register allocation, never the
+//! arithmetic (FMA is not enabled: the compiler never contracts without it being asked,
+//! and de Casteljau's averages must round as in the `f64` reference and the neighbours).
 
-use super::float::GBox;
+use super::config::SubdivisionConfig;
+use glam::{Mat4, Vec3A, Vec4};
+
+use super::float::{GBox, GRay};
 use super::heuristics::Corners;
 use super::param::Split;
-use super::search::NetStack;
+use super::search::{NetStack, Node, SearchHit, search};
+use crate::geom::bbox::slab;
+use crate::kernel::KernelStats;
 
 /// A control net of fixed size held in SIMD registers.
 pub trait RegisterNet: Copy {
     /// Splits at 1/2 in `dir`: `self` becomes the lower half, the upper half is returned.
     fn split_in_place(&mut self, dir: Split) -> Self;
-    /// The control box of the net.
-    fn bounds(&self) -> GBox<f32>;
+    /// The control boxes of two nets as `(min, max)` vectors, computed together so that
+    /// their horizontal reductions share shuffles.
+    fn bounds_pair(a: &Self, b: &Self) -> [(Vec3A, Vec3A); 2];
     /// Corner points `b(0,0)`, `b(n,0)`, `b(0,m)` for the split heuristics.
     fn corners(&self) -> Corners<f32>;
+
+    /// The control box of the net.
+    fn bounds(&self) -> GBox<f32> {
+        let [(min, max), _] = Self::bounds_pair(self, self);
+        GBox {
+            min: min.to_array(),
+            max: max.to_array(),
+        }
+    }
 }
 
-/// The current net by value; the pushed nets in `slots[..top]` and the pending upper child
-/// of the last split in `slots[top]`, so that pushing it is no copy.
+/// Horizontal reduction of three registers with `f` (lane-wise min or max) into the lanes
+/// x, y, z of one: a 4×4 transpose and two lane-wise steps instead of three separate
+/// two-shuffle reductions and their scalar extractions.
+#[inline(always)]
+pub fn reduce3(a: Vec4, b: Vec4, c: Vec4, f: impl Fn(Vec4, Vec4) -> Vec4) -> Vec3A {
+    let m = Mat4::from_cols(a, b, c, c).transpose();
+    Vec3A::from_vec4(f(f(m.x_axis, m.y_axis), f(m.z_axis, m.w_axis)))
+}
+
+/// The current net and the pending upper child of the last split by value (in registers
+/// where the compiler can keep them); the pushed nets in `slots[..top]`. A split writes the
+/// lower child over `cur`; pushing the farther child is one store of it, whichever it is.
 pub struct RegisterStack<'a, N> {
     pub cur: N,
+    pub pending: N,
     pub slots: &'a mut Vec<N>,
     pub top: usize,
 }
@@ -31,11 +65,9 @@ impl<'a, N: RegisterNet> RegisterStack<'a, N> {
     /// A stack holding only `root`; `slots` is reused scratch.
     #[inline(always)]
     pub fn new(root: N, slots: &'a mut Vec<N>) -> Self {
-        if slots.is_empty() {
-            slots.push(root);
-        }
         RegisterStack {
             cur: root,
+            pending: root,
             slots,
             top: 0,
         }
@@ -49,27 +81,47 @@ impl<N: RegisterNet> NetStack<f32> for RegisterStack<'_, N> {
     }
 
     #[inline(always)]
-    fn split(&mut self, dir: Split) -> [GBox<f32>; 2] {
-        let upper = &mut self.slots[self.top];
-        *upper = self.cur.split_in_place(dir);
-        [self.cur.bounds(), upper.bounds()]
+    fn split_test(
+        &mut self,
+        dir: Split,
+        ray: &GRay<f32>,
+        tmax: f32,
+    ) -> [(GBox<f32>, Option<f32>); 2] {
+        self.pending = self.cur.split_in_place(dir);
+        let (origin, inv_dir) = (
+            Vec3A::from_array(ray.origin),
+            Vec3A::from_array(ray.inv_dir),
+        );
+        N::bounds_pair(&self.cur, &self.pending).map(|(min, max)| {
+            let hit = slab(min, max, origin, inv_dir, ray.tmin, tmax).map(|(t, _)| t);
+            (
+                GBox {
+                    min: min.to_array(),
+                    max: max.to_array(),
+                },
+                hit,
+            )
+        })
     }
 
     #[inline(always)]
     fn push_far(&mut self, far_is_lower: bool) {
-        if far_is_lower {
-            std::mem::swap(&mut self.cur, &mut self.slots[self.top]);
+        let far = if far_is_lower {
+            std::mem::replace(&mut self.cur, self.pending)
+        } else {
+            self.pending
+        };
+        match self.slots.get_mut(self.top) {
+            Some(slot) => *slot = far,
+            None => self.slots.push(far),
         }
         self.top += 1;
-        if self.slots.len() == self.top {
-            self.slots.push(self.cur);
-        }
     }
 
     #[inline(always)]
     fn keep(&mut self, lower: bool) {
         if !lower {
-            self.cur = self.slots[self.top];
+            self.cur = self.pending;
         }
     }
 
@@ -80,4 +132,81 @@ impl<N: RegisterNet> NetStack<f32> for RegisterStack<'_, N> {
             self.cur = self.slots[top];
         }
     }
+}
+
+/// The search of [`super::search`] on a register net, compiled for the best instruction set
+/// the CPU offers (see the module documentation).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub fn search_register<N: RegisterNet>(
+    net: N,
+    slots: &mut Vec<N>,
+    nodes: &mut Vec<Node<f32>>,
+    root: GBox<f32>,
+    ray: &GRay<f32>,
+    cfg: &SubdivisionConfig,
+    any_hit: bool,
+    stats: &mut KernelStats,
+) -> Option<SearchHit<f32>> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl") {
+            // SAFETY: the CPU has the features the function is compiled for.
+            return unsafe { search_avx512(net, slots, nodes, root, ray, cfg, any_hit, stats) };
+        }
+        if is_x86_feature_detected!("avx2") {
+            // SAFETY: as above.
+            return unsafe { search_avx2(net, slots, nodes, root, ray, cfg, any_hit, stats) };
+        }
+    }
+    search_portable(net, slots, nodes, root, ray, cfg, any_hit, stats)
+}
+
+/// The search itself, inlined into each instruction-set version.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn search_portable<N: RegisterNet>(
+    net: N,
+    slots: &mut Vec<N>,
+    nodes: &mut Vec<Node<f32>>,
+    root: GBox<f32>,
+    ray: &GRay<f32>,
+    cfg: &SubdivisionConfig,
+    any_hit: bool,
+    stats: &mut KernelStats,
+) -> Option<SearchHit<f32>> {
+    let mut nets = RegisterStack::new(net, slots);
+    search(&mut nets, nodes, root, ray, false, cfg, any_hit, stats)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[allow(clippy::too_many_arguments)]
+#[target_feature(enable = "avx2,avx512f,avx512vl")]
+fn search_avx512<N: RegisterNet>(
+    net: N,
+    slots: &mut Vec<N>,
+    nodes: &mut Vec<Node<f32>>,
+    root: GBox<f32>,
+    ray: &GRay<f32>,
+    cfg: &SubdivisionConfig,
+    any_hit: bool,
+    stats: &mut KernelStats,
+) -> Option<SearchHit<f32>> {
+    search_portable(net, slots, nodes, root, ray, cfg, any_hit, stats)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[allow(clippy::too_many_arguments)]
+#[target_feature(enable = "avx2")]
+fn search_avx2<N: RegisterNet>(
+    net: N,
+    slots: &mut Vec<N>,
+    nodes: &mut Vec<Node<f32>>,
+    root: GBox<f32>,
+    ray: &GRay<f32>,
+    cfg: &SubdivisionConfig,
+    any_hit: bool,
+    stats: &mut KernelStats,
+) -> Option<SearchHit<f32>> {
+    search_portable(net, slots, nodes, root, ray, cfg, any_hit, stats)
 }

@@ -23,8 +23,11 @@ pub trait NetStack<T: KernelFloat> {
     /// Corner points of the current net for the split heuristics.
     fn corners(&self) -> Corners<T>;
     /// Splits the current net at 1/2 in `dir` into a lower and an upper child, both pending,
-    /// and returns their boxes (lower first).
-    fn split(&mut self, dir: Split) -> [GBox<T>; 2];
+    /// and returns their boxes (lower first), each with the entry `t` of the slab test
+    /// ([`KernelFloat::slab`]) against `ray` clipped to `tmax` if the ray hits it. The split
+    /// and the test are one step so that the fast paths can compute both boxes and both
+    /// tests together in SIMD registers.
+    fn split_test(&mut self, dir: Split, ray: &GRay<T>, tmax: T) -> [(GBox<T>, Option<T>); 2];
     /// Both pending children are hit: push the farther one, continue with the nearer.
     fn push_far(&mut self, far_is_lower: bool);
     /// Only one pending child is hit: continue with it, drop the other.
@@ -103,7 +106,8 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
             };
             stats.splits += 1;
             stats.box_tests += 2;
-            let boxes = nets.split(dir);
+            let [(box0, hit0), (box1, hit1)] = nets.split_test(dir, ray, tmax);
+            let boxes = [box0, box1];
             let cells = cur.cell.split(dir);
             let d = cur.bbox.l1_diameter();
             let child = |i: usize, t_enter: T| {
@@ -121,8 +125,8 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
                         || (rational && b.mantissa_close(cfg.rational_dist)),
                 }
             };
-            match (T::slab(&boxes[0], ray, tmax), T::slab(&boxes[1], ray, tmax)) {
-                (Some((t0, _)), Some((t1, _))) => {
+            match (hit0, hit1) {
+                (Some(t0), Some(t1)) => {
                     let far_is_lower = t1 < t0;
                     nets.push_far(far_is_lower);
                     if far_is_lower {
@@ -134,12 +138,12 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
                     }
                     continue;
                 }
-                (Some((t0, _)), None) => {
+                (Some(t0), None) => {
                     nets.keep(true);
                     cur = child(0, t0);
                     continue;
                 }
-                (None, Some((t1, _))) => {
+                (None, Some(t1)) => {
                     nets.keep(false);
                     cur = child(1, t1);
                     continue;
