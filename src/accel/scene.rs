@@ -1,13 +1,15 @@
 //! The scene as the renderer sees it: every Bézier patch prepared for the kernel in `f32`,
 //! its `f64` original kept for normals and the reference path, every mesh triangle in `f32`
-//! for the watertight kernel, and one BVH over the tight patch boxes (LG90 §3.1, Fig. 2)
-//! and the triangle boxes. Primitive `i` of the BVH is patch `i` when `i` is below the
-//! patch count, and triangle `i - patch count` otherwise. One query answers "nearest hit"
-//! or "anything in the way" for a ray, counting the work it did.
+//! for the watertight kernel, and one accelerator over them: a BVH over the tight patch
+//! boxes (LG90 §3.1, Fig. 2) and the triangle boxes, or the uniform grid of LG90 §3.1.
+//! Primitive `i` of either is patch `i` when `i` is below the patch count, and triangle
+//! `i - patch count` otherwise. One query answers "nearest hit" or "anything in the way"
+//! for a ray, counting the work it did.
 
 use glam::{DVec3, Vec3};
 
 use super::bvh::{Bvh, GeometryHasher};
+use super::grid::Grid;
 use crate::geom::{Aabb, BezierPatch, DAabb, Ray};
 use crate::kernel::subdivision::{self, PreparedPatch, SubdivisionConfig};
 use crate::kernel::triangle::{self, RayShear, TriangleHit};
@@ -28,7 +30,10 @@ pub enum Precision {
 pub struct QueryStats {
     pub kernel: KernelStats,
     pub nodes_visited: u64,
+    /// Box tests of the accelerator: BVH node boxes, or the grid's tight primitive boxes.
     pub bvh_box_tests: u64,
+    /// Grid voxels stepped through (0 with the BVH).
+    pub voxels_visited: u64,
 }
 
 impl QueryStats {
@@ -36,6 +41,7 @@ impl QueryStats {
         self.kernel.add(&o.kernel);
         self.nodes_visited += o.nodes_visited;
         self.bvh_box_tests += o.bvh_box_tests;
+        self.voxels_visited += o.voxels_visited;
     }
 }
 
@@ -75,6 +81,12 @@ enum Candidate {
     Triangle(u32, TriangleHit),
 }
 
+/// The acceleration structure over the primitives.
+enum Accel {
+    Bvh(Bvh),
+    Grid(Grid),
+}
+
 /// Prepared geometry of a scene.
 pub struct SceneGeometry {
     prepared: Vec<PreparedPatch>,
@@ -82,7 +94,7 @@ pub struct SceneGeometry {
     /// (object, patch within object) per patch.
     ids: Vec<(u32, u32)>,
     triangles: Triangles,
-    bvh: Bvh,
+    accel: Accel,
 }
 
 impl SceneGeometry {
@@ -101,14 +113,23 @@ impl SceneGeometry {
             )
             .collect();
         let bvh = Bvh::build(&boxes);
-        Self::with_bvh(originals, ids, triangles, bvh)
+        Self::with_accel(originals, ids, triangles, Accel::Bvh(bvh))
     }
 
-    fn with_bvh(
+    /// Prepares the patches and builds the uniform grid of LG90 §3.1 within `budget_bytes`
+    /// (see [`Grid::build`]).
+    pub fn build_grid(scene: &Scene, budget_bytes: usize) -> SceneGeometry {
+        let (originals, ids) = collect_patches(scene);
+        let triangles = collect_triangles(scene);
+        let grid = Grid::build(&originals, &triangles.corners, budget_bytes);
+        Self::with_accel(originals, ids, triangles, Accel::Grid(grid))
+    }
+
+    fn with_accel(
         originals: Vec<BezierPatch>,
         ids: Vec<(u32, u32)>,
         triangles: Triangles,
-        bvh: Bvh,
+        accel: Accel,
     ) -> SceneGeometry {
         let prepared = originals.iter().map(PreparedPatch::new).collect();
         SceneGeometry {
@@ -116,7 +137,7 @@ impl SceneGeometry {
             originals,
             ids,
             triangles,
-            bvh,
+            accel,
         }
     }
 
@@ -126,8 +147,20 @@ impl SceneGeometry {
         hash_geometry(&self.originals, &self.triangles)
     }
 
-    pub fn bvh(&self) -> &Bvh {
-        &self.bvh
+    /// The BVH, when the geometry was prepared with one.
+    pub fn bvh(&self) -> Option<&Bvh> {
+        match &self.accel {
+            Accel::Bvh(bvh) => Some(bvh),
+            Accel::Grid(_) => None,
+        }
+    }
+
+    /// The grid, when the geometry was prepared with one.
+    pub fn grid(&self) -> Option<&Grid> {
+        match &self.accel {
+            Accel::Grid(grid) => Some(grid),
+            Accel::Bvh(_) => None,
+        }
     }
 
     pub fn patch_count(&self) -> usize {
@@ -139,7 +172,55 @@ impl SceneGeometry {
     }
 
     pub fn bounds(&self) -> Aabb {
-        self.bvh.bounds()
+        match &self.accel {
+            Accel::Bvh(bvh) => bvh.bounds(),
+            Accel::Grid(grid) => grid.bounds(),
+        }
+    }
+
+    /// Nearest-first traversal of the accelerator (see [`Bvh::traverse`] and
+    /// [`Grid::traverse`]), adding its work to `stats`.
+    fn traverse(
+        &self,
+        ray: &Ray,
+        hit: impl FnMut(u32, f32) -> Option<f32>,
+        stats: &mut QueryStats,
+    ) {
+        match &self.accel {
+            Accel::Bvh(bvh) => {
+                let t = bvh.traverse(ray, hit);
+                stats.nodes_visited += t.nodes_visited;
+                stats.bvh_box_tests += t.box_tests;
+            }
+            Accel::Grid(grid) => {
+                let g = grid.traverse(ray, hit);
+                stats.voxels_visited += g.voxels_visited;
+                stats.bvh_box_tests += g.box_tests;
+            }
+        }
+    }
+
+    /// Any-hit traversal of the accelerator, adding its work to `stats`.
+    fn traverse_any(
+        &self,
+        ray: &Ray,
+        hit: impl FnMut(u32) -> bool,
+        stats: &mut QueryStats,
+    ) -> bool {
+        match &self.accel {
+            Accel::Bvh(bvh) => {
+                let (found, t) = bvh.traverse_any(ray, hit);
+                stats.nodes_visited += t.nodes_visited;
+                stats.bvh_box_tests += t.box_tests;
+                found
+            }
+            Accel::Grid(grid) => {
+                let (found, g) = grid.traverse_any(ray, hit);
+                stats.voxels_visited += g.voxels_visited;
+                stats.bvh_box_tests += g.box_tests;
+                found
+            }
+        }
     }
 
     /// The nearest hit along `ray` in `[ray.tmin, ray.tmax]`.
@@ -168,25 +249,31 @@ impl SceneGeometry {
         let mut kernel = KernelStats::default();
         let shear = RayShear::new(ray);
         let patches = self.prepared.len() as u32;
-        let t = self.bvh.traverse(ray, |prim, tmax| {
-            kernel.patch_tests += (prim >= patches) as u64;
-            if prim < patches {
-                let r = Ray { tmax, ..*ray };
-                let hit =
-                    subdivision::intersect(&self.prepared[prim as usize], &r, cfg, &mut kernel)?;
-                best = Some(Candidate::Patch(prim, hit));
-                Some(hit.t)
-            } else {
-                let k = prim - patches;
-                let [a, b, c] = self.triangles.corners[k as usize];
-                let hit = triangle::intersect_triangle(&shear, a, b, c, ray.tmin, tmax)?;
-                best = Some(Candidate::Triangle(k, hit));
-                Some(hit.t)
-            }
-        });
+        self.traverse(
+            ray,
+            |prim, tmax| {
+                kernel.patch_tests += (prim >= patches) as u64;
+                if prim < patches {
+                    let r = Ray { tmax, ..*ray };
+                    let hit = subdivision::intersect(
+                        &self.prepared[prim as usize],
+                        &r,
+                        cfg,
+                        &mut kernel,
+                    )?;
+                    best = Some(Candidate::Patch(prim, hit));
+                    Some(hit.t)
+                } else {
+                    let k = prim - patches;
+                    let [a, b, c] = self.triangles.corners[k as usize];
+                    let hit = triangle::intersect_triangle(&shear, a, b, c, ray.tmin, tmax)?;
+                    best = Some(Candidate::Triangle(k, hit));
+                    Some(hit.t)
+                }
+            },
+            stats,
+        );
         stats.kernel.add(&kernel);
-        stats.nodes_visited += t.nodes_visited;
-        stats.bvh_box_tests += t.box_tests;
         Some(match best? {
             Candidate::Patch(prim, h) => {
                 self.finish_patch_hit(prim, h.t as f64, h.u as f64, h.v as f64, h.hit_box)
@@ -256,18 +343,26 @@ impl SceneGeometry {
                 let mut kernel = KernelStats::default();
                 let patches = self.prepared.len() as u32;
                 let shear = RayShear::new(ray);
-                let (hit, t) = self.bvh.traverse_any(ray, |prim| {
-                    if prim < patches {
-                        subdivision::occluded(&self.prepared[prim as usize], ray, cfg, &mut kernel)
-                    } else {
-                        kernel.patch_tests += 1;
-                        let [a, b, c] = self.triangles.corners[(prim - patches) as usize];
-                        triangle::intersect_triangle(&shear, a, b, c, ray.tmin, ray.tmax).is_some()
-                    }
-                });
+                let hit = self.traverse_any(
+                    ray,
+                    |prim| {
+                        if prim < patches {
+                            subdivision::occluded(
+                                &self.prepared[prim as usize],
+                                ray,
+                                cfg,
+                                &mut kernel,
+                            )
+                        } else {
+                            kernel.patch_tests += 1;
+                            let [a, b, c] = self.triangles.corners[(prim - patches) as usize];
+                            triangle::intersect_triangle(&shear, a, b, c, ray.tmin, ray.tmax)
+                                .is_some()
+                        }
+                    },
+                    stats,
+                );
                 stats.kernel.add(&kernel);
-                stats.nodes_visited += t.nodes_visited;
-                stats.bvh_box_tests += t.box_tests;
                 hit
             }
             Precision::F64(_) => self.intersect(ray, precision, stats).is_some(),
@@ -357,13 +452,19 @@ impl SceneGeometry {
                 "the BVH indexes a different number of patches than the scene; rebuild it with `patchtrace bvh`",
             ));
         }
-        Ok(Self::with_bvh(originals, ids, triangles, bvh))
+        Ok(Self::with_accel(originals, ids, triangles, Accel::Bvh(bvh)))
     }
 
-    /// Writes the BVH with the scene's geometry hash, atomically.
+    /// Writes the BVH with the scene's geometry hash, atomically; refused for a grid.
     pub fn save_bvh(&self, path: &std::path::Path) -> Result<(), crate::scene::LoadError> {
+        let Accel::Bvh(bvh) = &self.accel else {
+            return Err(crate::scene::LoadError::invalid(
+                path,
+                "the geometry was prepared with a grid, which has no BVH to write",
+            ));
+        };
         let hash = self.geometry_hash();
-        crate::scene::write::write_atomic(path, |w| self.bvh.write(w, hash))
+        crate::scene::write::write_atomic(path, |w| bvh.write(w, hash))
     }
 }
 

@@ -177,6 +177,22 @@ pub struct KernelArgs {
     /// Load the BVH from this file (written by `patchtrace bvh`) instead of building it.
     #[arg(long, value_name = "FILE")]
     pub bvh: Option<PathBuf>,
+    /// Acceleration structure over the patches.
+    #[arg(long, value_enum, default_value_t = AccelChoice::Bvh)]
+    pub accel: AccelChoice,
+    /// Memory budget of `--accel grid`, in MiB: voxels are made coarser until the grid
+    /// fits (LG90 §3.1).
+    #[arg(long, value_name = "MIB", default_value_t = crate::accel::grid::DEFAULT_BUDGET_BYTES >> 20)]
+    pub grid_budget: usize,
+}
+
+/// Acceleration structure.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum AccelChoice {
+    /// SAH bounding volume hierarchy over tight patch boxes (Dammertz §3.2).
+    Bvh,
+    /// Uniform grid with voxel lists and mailboxes (Lischinski & Gonczarowski 1990, §3.1).
+    Grid,
 }
 
 #[derive(Debug, Args)]

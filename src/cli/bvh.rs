@@ -17,7 +17,7 @@ pub fn run(args: BvhArgs) -> anyhow::Result<ExitCode> {
         "wrote {}: {} patches, {} nodes, built in {:.3} s",
         args.output.display(),
         geometry.patch_count(),
-        geometry.bvh().node_count(),
+        geometry.bvh().map_or(0, |b| b.node_count()),
         build
     );
     Ok(ExitCode::SUCCESS)

@@ -1,5 +1,5 @@
 //! Turning shared flags into a validated configuration: the scene, its prepared geometry
-//! (BVH built or loaded), the kernel settings and the worker pool.
+//! (BVH built or loaded, or grid built), the kernel settings and the worker pool.
 
 use std::path::Path;
 use std::time::Instant;
@@ -7,7 +7,7 @@ use std::time::Instant;
 use anyhow::Context;
 
 use crate::accel::scene::{Precision, SceneGeometry};
-use crate::cli::args::{HeuristicChoice, KernelArgs, KernelChoice, PrecisionChoice};
+use crate::cli::args::{AccelChoice, HeuristicChoice, KernelArgs, KernelChoice, PrecisionChoice};
 use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig};
 use crate::scene::{Scene, load_scene};
 
@@ -38,15 +38,23 @@ pub struct Prepared {
     pub prepare_seconds: f64,
 }
 
-/// Loads the scene and prepares its geometry, building the BVH or loading `--bvh`.
+/// Loads the scene and prepares its geometry: builds the BVH or loads `--bvh`, or builds
+/// the grid for `--accel grid`.
 pub fn prepare(scene_path: &Path, args: &KernelArgs) -> anyhow::Result<Prepared> {
+    anyhow::ensure!(
+        args.accel == AccelChoice::Bvh || args.bvh.is_none(),
+        "--bvh loads a BVH file, which --accel grid does not use; drop one of the two flags"
+    );
     let start = Instant::now();
     let scene = load_scene(scene_path)?;
     let load_seconds = start.elapsed().as_secs_f64();
     let start = Instant::now();
-    let geometry = match &args.bvh {
-        Some(path) => SceneGeometry::load(&scene, path)?,
-        None => SceneGeometry::build(&scene),
+    let geometry = match (args.accel, &args.bvh) {
+        (AccelChoice::Bvh, Some(path)) => SceneGeometry::load(&scene, path)?,
+        (AccelChoice::Bvh, None) => SceneGeometry::build(&scene),
+        (AccelChoice::Grid, _) => {
+            SceneGeometry::build_grid(&scene, args.grid_budget.saturating_mul(1 << 20))
+        }
     };
     Ok(Prepared {
         scene,

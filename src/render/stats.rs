@@ -71,6 +71,7 @@ pub struct RayTally {
     splits: Tally,
     box_tests: Tally,
     nodes: Tally,
+    voxels: Tally,
 }
 
 impl RayTally {
@@ -80,6 +81,7 @@ impl RayTally {
         self.splits.push(q.kernel.splits);
         self.box_tests.push(q.kernel.box_tests + q.bvh_box_tests);
         self.nodes.push(q.nodes_visited);
+        self.voxels.push(q.voxels_visited);
     }
 
     pub fn merge(mut self, o: RayTally) -> RayTally {
@@ -90,6 +92,7 @@ impl RayTally {
         self.splits.merge(&o.splits);
         self.box_tests.merge(&o.box_tests);
         self.nodes.merge(&o.nodes);
+        self.voxels.merge(&o.voxels);
         self
     }
 
@@ -118,6 +121,7 @@ impl RayTally {
             splits_per_ray: self.splits.spread(n),
             box_tests_per_ray: self.box_tests.spread(n),
             bvh_nodes_per_ray: self.nodes.spread(n),
+            voxels_per_ray: self.voxels.spread(n),
         }
     }
 }
@@ -133,6 +137,8 @@ pub struct RayReport {
     pub splits_per_ray: Spread,
     pub box_tests_per_ray: Spread,
     pub bvh_nodes_per_ray: Spread,
+    /// Grid voxels stepped through (`--accel grid`; 0 with the BVH).
+    pub voxels_per_ray: Spread,
 }
 
 /// Wall-clock seconds per phase.
