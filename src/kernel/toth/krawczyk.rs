@@ -103,3 +103,76 @@ pub fn newton_step(inverse: &Mat2, g: &IPoint) -> [f64; 2] {
         -(inverse[1][0] * a + inverse[1][1] * b),
     ]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{BezierPatch, Ray};
+    use crate::kernel::toth::raynet::RayFrame;
+    use glam::{DVec3, Vec3};
+
+    /// A planar parallelogram `p + u a + v b` and a ray through its point (0.3, 0.6): the
+    /// root is known in closed form, and g is linear, so Krawczyk's operator is exact up
+    /// to rounding.
+    fn setup() -> (IntervalNet, Ray) {
+        let (p, a, b) = (
+            DVec3::new(1.0, 2.0, 0.5),
+            DVec3::new(2.0, 0.5, 0.0),
+            DVec3::new(-0.5, 3.0, 1.0),
+        );
+        let patch = BezierPatch::from_points(1, 1, &[p, p + a, p + b, p + a + b]).unwrap();
+        let target = p + 0.3 * a + 0.6 * b;
+        let ray = Ray::new(
+            Vec3::new(0.0, 0.0, 9.0),
+            (target - DVec3::new(0.0, 0.0, 9.0)).as_vec3(),
+        );
+        let mut net = IntervalNet::default();
+        RayFrame::new(&ray).project(patch.homogeneous_points(), 2, 2, &mut net);
+        (net, ray)
+    }
+
+    fn sub(net: &IntervalNet, x: &ParamBox) -> IntervalNet {
+        let mut s = IntervalNet::default();
+        net.subnet_into(x, &mut s);
+        s
+    }
+
+    #[test]
+    fn the_whole_domain_of_a_plane_is_a_safe_region_around_the_root() {
+        let (net, _) = setup();
+        let x = ParamBox::UNIT;
+        match classify(&net, &sub(&net, &x), &x) {
+            Classification::Safe {
+                region,
+                contraction,
+                ..
+            } => {
+                // The ray is rounded to f32, so the root moves by f32 ulps of (0.3, 0.6).
+                assert!((region.u.mid() - 0.3).abs() < 1e-6 && (region.v.mid() - 0.6).abs() < 1e-6);
+                assert!(
+                    region.width() < 1e-9,
+                    "K of a linear system is a point: {region:?}"
+                );
+                assert!(contraction < 1e-9);
+            }
+            other => panic!("expected a safe region, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_box_away_from_the_root_is_excluded() {
+        let (net, _) = setup();
+        let x = ParamBox {
+            u: Interval::new(0.5, 1.0).unwrap(),
+            v: Interval::new(0.0, 0.5).unwrap(),
+        };
+        assert_eq!(classify(&net, &sub(&net, &x), &x), Classification::Excluded);
+    }
+
+    #[test]
+    fn inverse_of_a_singular_matrix_is_refused() {
+        assert!(invert([[1.0, 2.0], [2.0, 4.0]]).is_none());
+        let m = invert([[2.0, 1.0], [1.0, 1.0]]).unwrap();
+        assert_eq!(m, [[1.0, -1.0], [-1.0, 2.0]]);
+    }
+}
