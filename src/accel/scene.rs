@@ -12,6 +12,7 @@ use super::bvh::{Bvh, GeometryHasher};
 use super::grid::Grid;
 use crate::geom::{Aabb, BezierPatch, DAabb, Ray};
 use crate::kernel::subdivision::{self, PreparedPatch, SubdivisionConfig};
+use crate::kernel::toth::{self, TothConfig};
 use crate::kernel::triangle::{self, RayShear, TriangleHit};
 use crate::kernel::{KernelStats, PatchHit};
 use crate::scene::{Geometry, Scene};
@@ -23,6 +24,8 @@ pub enum Precision {
     F32(SubdivisionConfig),
     /// The same algorithm in `f64`: the accuracy reference.
     F64(SubdivisionConfig),
+    /// Toth's interval Newton kernel (LG90 §4.1) on the `f64` patches, `f32` rays.
+    Toth(TothConfig),
 }
 
 /// Work done by one query.
@@ -231,7 +234,7 @@ impl SceneGeometry {
         stats: &mut QueryStats,
     ) -> Option<SceneHit> {
         match precision {
-            Precision::F32(cfg) => self.intersect_f32(ray, cfg, stats),
+            Precision::F32(_) | Precision::Toth(_) => self.intersect_f32(ray, precision, stats),
             Precision::F64(cfg) => {
                 let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
                 self.intersect_f64(o, d, ray.tmin as f64, ray.tmax as f64, cfg, stats)
@@ -242,7 +245,7 @@ impl SceneGeometry {
     fn intersect_f32(
         &self,
         ray: &Ray,
-        cfg: &SubdivisionConfig,
+        precision: &Precision,
         stats: &mut QueryStats,
     ) -> Option<SceneHit> {
         let mut best: Option<Candidate> = None;
@@ -255,12 +258,7 @@ impl SceneGeometry {
                 kernel.patch_tests += (prim >= patches) as u64;
                 if prim < patches {
                     let r = Ray { tmax, ..*ray };
-                    let hit = subdivision::intersect(
-                        &self.prepared[prim as usize],
-                        &r,
-                        cfg,
-                        &mut kernel,
-                    )?;
+                    let hit = self.patch_hit(prim, &r, precision, &mut kernel)?;
                     best = Some(Candidate::Patch(prim, hit));
                     Some(hit.t)
                 } else {
@@ -339,7 +337,7 @@ impl SceneGeometry {
     /// True when anything blocks `ray` in `[tmin, tmax]` (shadow rays).
     pub fn occluded(&self, ray: &Ray, precision: &Precision, stats: &mut QueryStats) -> bool {
         match precision {
-            Precision::F32(cfg) => {
+            Precision::F32(_) | Precision::Toth(_) => {
                 let mut kernel = KernelStats::default();
                 let patches = self.prepared.len() as u32;
                 let shear = RayShear::new(ray);
@@ -347,12 +345,7 @@ impl SceneGeometry {
                     ray,
                     |prim| {
                         if prim < patches {
-                            subdivision::occluded(
-                                &self.prepared[prim as usize],
-                                ray,
-                                cfg,
-                                &mut kernel,
-                            )
+                            self.patch_occluded(prim, ray, precision, &mut kernel)
                         } else {
                             kernel.patch_tests += 1;
                             let [a, b, c] = self.triangles.corners[(prim - patches) as usize];
@@ -366,6 +359,42 @@ impl SceneGeometry {
                 hit
             }
             Precision::F64(_) => self.intersect(ray, precision, stats).is_some(),
+        }
+    }
+
+    /// Nearest hit on patch `prim` by the `f32`-ray kernel `precision` selects.
+    fn patch_hit(
+        &self,
+        prim: u32,
+        ray: &Ray,
+        precision: &Precision,
+        kernel: &mut KernelStats,
+    ) -> Option<PatchHit> {
+        match precision {
+            Precision::Toth(cfg) => {
+                toth::intersect(&self.originals[prim as usize], ray, cfg, kernel)
+            }
+            Precision::F32(cfg) | Precision::F64(cfg) => {
+                subdivision::intersect(&self.prepared[prim as usize], ray, cfg, kernel)
+            }
+        }
+    }
+
+    /// Whether patch `prim` blocks `ray`, by the kernel `precision` selects.
+    fn patch_occluded(
+        &self,
+        prim: u32,
+        ray: &Ray,
+        precision: &Precision,
+        kernel: &mut KernelStats,
+    ) -> bool {
+        match precision {
+            Precision::Toth(cfg) => {
+                toth::occluded(&self.originals[prim as usize], ray, cfg, kernel)
+            }
+            Precision::F32(cfg) | Precision::F64(cfg) => {
+                subdivision::occluded(&self.prepared[prim as usize], ray, cfg, kernel)
+            }
         }
     }
 

@@ -138,6 +138,8 @@ pub struct ConvertArgs {
 pub enum KernelChoice {
     /// Dammertz's float-precision subdivision (§2.2–2.3, §2.7).
     Subdivision,
+    /// Toth's interval Newton with Krawczyk's operator (Lischinski & Gonczarowski §4.1).
+    Toth,
 }
 
 /// Arithmetic of the kernel.
@@ -174,6 +176,10 @@ pub struct KernelArgs {
     /// (Dammertz §2.7.2).
     #[arg(long, value_name = "ULPS")]
     pub rational_dist: Option<u32>,
+    /// Shadow rays stop at the first safe region, without Newton iteration (Lischinski &
+    /// Gonczarowski §6, the ISRT column). Only with `--kernel toth`.
+    #[arg(long)]
+    pub isrt: bool,
     /// Load the BVH from this file (written by `patchtrace bvh`) instead of building it.
     #[arg(long, value_name = "FILE")]
     pub bvh: Option<PathBuf>,

@@ -43,6 +43,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
             .into());
         }
     }
+    let precision = precision(&args.kernel)?;
     let pool = thread_pool(args.threads)?;
     let mut prepared = prepare(&args.scene, &args.kernel)?;
     let scene = &mut prepared.scene;
@@ -53,7 +54,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         scene,
         geometry: &prepared.geometry,
         settings: TraceSettings {
-            precision: precision(&args.kernel),
+            precision,
             ulps: args.ulps,
             plan,
         },

@@ -9,11 +9,25 @@ use anyhow::Context;
 use crate::accel::scene::{Precision, SceneGeometry};
 use crate::cli::args::{AccelChoice, HeuristicChoice, KernelArgs, KernelChoice, PrecisionChoice};
 use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig};
+use crate::kernel::toth::TothConfig;
 use crate::scene::{Scene, load_scene};
 
-/// The kernel path selected by the flags.
-pub fn precision(args: &KernelArgs) -> Precision {
-    let KernelChoice::Subdivision = args.kernel;
+/// The kernel path selected by the flags, or why the flags do not go together.
+pub fn precision(args: &KernelArgs) -> anyhow::Result<Precision> {
+    if args.kernel == KernelChoice::Toth {
+        anyhow::ensure!(
+            args.precision == PrecisionChoice::F32,
+            "--kernel toth works on f32 rays and has no --precision f64 variant; use --kernel subdivision --precision f64 for the reference"
+        );
+        return Ok(Precision::Toth(TothConfig {
+            isrt: args.isrt,
+            ..TothConfig::default()
+        }));
+    }
+    anyhow::ensure!(
+        !args.isrt,
+        "--isrt applies to the Toth kernel only; add --kernel toth"
+    );
     let mut cfg = SubdivisionConfig {
         heuristic: match args.heuristic {
             HeuristicChoice::Length => SplitHeuristic::Length,
@@ -24,10 +38,10 @@ pub fn precision(args: &KernelArgs) -> Precision {
     if let Some(d) = args.rational_dist {
         cfg.rational_dist = d;
     }
-    match args.precision {
+    Ok(match args.precision {
         PrecisionChoice::F32 => Precision::F32(cfg),
         PrecisionChoice::F64 => Precision::F64(cfg),
-    }
+    })
 }
 
 /// Loaded scene and prepared geometry, with the seconds each took.

@@ -19,10 +19,10 @@ use crate::scene::write::write_atomic;
 pub const TRACE_HEADER: &str = "ray,hit,t,object,patch,u,v,px,py,pz,nx,ny,nz";
 
 pub fn run(args: TraceArgs) -> anyhow::Result<ExitCode> {
+    let precision = precision(&args.kernel)?;
     let src = read_text(&args.rays)?;
     let rays = parse_rays(&args.rays, &src)?;
     let prepared = prepare(&args.scene, &args.kernel)?;
-    let precision = precision(&args.kernel);
     let pool = thread_pool(args.threads)?;
     let rows: Vec<String> = pool.install(|| {
         rays.par_iter()
@@ -53,7 +53,7 @@ fn trace_one(
 ) -> Option<(SceneHit, DVec3, DVec3)> {
     let mut stats = QueryStats::default();
     match precision {
-        Precision::F32(_) => {
+        Precision::F32(_) | Precision::Toth(_) => {
             let ray = Ray {
                 origin: q.origin.as_vec3(),
                 dir: q.dir.as_vec3(),

@@ -1,6 +1,6 @@
 //! Pure math: Bézier patches (evaluation, derivatives, de Casteljau split, rational
 //! patches), NURBS (knot vectors, Boehm insertion, Bézier decomposition), bounding boxes,
-//! rays and floating-point helpers. Nothing here knows about files or rendering.
+//! rays, outward-rounded interval arithmetic and floating-point helpers. Nothing here knows about files or rendering.
 //!
 //! Sources: de Casteljau evaluation and subdivision, and the tight box from one split
 //! (Lischinski & Gonczarowski 1990, §3.1, Fig. 2); NURBS algorithms from Piegl & Tiller,
@@ -9,6 +9,7 @@
 pub mod bbox;
 pub mod bezier;
 pub mod bicubic;
+pub mod interval;
 pub mod nurbs;
 pub mod ray;
 pub mod real;

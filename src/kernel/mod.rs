@@ -3,10 +3,12 @@
 //!
 //! - [`subdivision`]: Dammertz 2005 §2.2–2.3 and §2.7: subdivide until the bounding box
 //!   stops shrinking in `f32`, with an `f64` twin that is the accuracy reference.
+//! - [`toth`]: Toth's interval Newton with Krawczyk's operator (LG90 §4.1, §6).
 //! - [`secondary`]: origins of secondary rays at hit-box corners, §2.4.
 
 pub mod secondary;
 pub mod subdivision;
+pub mod toth;
 pub mod triangle;
 
 use crate::geom::Aabb;
@@ -31,6 +33,8 @@ pub struct KernelStats {
     pub splits: u64,
     /// Ray–box tests inside the kernel.
     pub box_tests: u64,
+    /// The Toth kernel's own counters (LG90 Tables 2–6 rows).
+    pub toth: toth::TothStats,
 }
 
 impl KernelStats {
@@ -38,5 +42,6 @@ impl KernelStats {
         self.patch_tests += other.patch_tests;
         self.splits += other.splits;
         self.box_tests += other.box_tests;
+        self.toth.add(&other.toth);
     }
 }

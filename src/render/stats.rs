@@ -3,6 +3,7 @@
 use serde::Serialize;
 
 use crate::accel::scene::QueryStats;
+use crate::kernel::toth::TothStats;
 
 /// The kinds of ray the integrator traces.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -72,6 +73,7 @@ pub struct RayTally {
     box_tests: Tally,
     nodes: Tally,
     voxels: Tally,
+    toth: TothStats,
 }
 
 impl RayTally {
@@ -82,6 +84,7 @@ impl RayTally {
         self.box_tests.push(q.kernel.box_tests + q.bvh_box_tests);
         self.nodes.push(q.nodes_visited);
         self.voxels.push(q.voxels_visited);
+        self.toth.add(&q.kernel.toth);
     }
 
     pub fn merge(mut self, o: RayTally) -> RayTally {
@@ -93,6 +96,7 @@ impl RayTally {
         self.box_tests.merge(&o.box_tests);
         self.nodes.merge(&o.nodes);
         self.voxels.merge(&o.voxels);
+        self.toth.add(&o.toth);
         self
     }
 
@@ -122,6 +126,7 @@ impl RayTally {
             box_tests_per_ray: self.box_tests.spread(n),
             bvh_nodes_per_ray: self.nodes.spread(n),
             voxels_per_ray: self.voxels.spread(n),
+            toth: (self.toth.searches > 0).then(|| TothReport::new(&self.toth, n)),
         }
     }
 }
@@ -139,6 +144,44 @@ pub struct RayReport {
     pub bvh_nodes_per_ray: Spread,
     /// Grid voxels stepped through (`--accel grid`; 0 with the BVH).
     pub voxels_per_ray: Spread,
+    /// The Toth kernel's rows of LG90 Tables 2–6, when it ran.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub toth: Option<TothReport>,
+}
+
+/// LG90 Tables 2–6 rows of the Toth kernel, per ray over all rays.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct TothReport {
+    pub surfaces_searched_per_ray: f64,
+    pub search_iterations_per_ray: f64,
+    pub newton_starts_per_ray: f64,
+    pub newton_iterations_per_call: f64,
+    pub mean_safe_region_width: f64,
+    pub isrt_early_outs: u64,
+    pub final_boxes: u64,
+    pub cut_off_searches: u64,
+}
+
+impl TothReport {
+    fn new(t: &TothStats, rays: u64) -> TothReport {
+        let per_ray = |x: u64| {
+            if rays == 0 {
+                0.0
+            } else {
+                x as f64 / rays as f64
+            }
+        };
+        TothReport {
+            surfaces_searched_per_ray: per_ray(t.searches),
+            search_iterations_per_ray: per_ray(t.search_iterations),
+            newton_starts_per_ray: per_ray(t.newton_starts),
+            newton_iterations_per_call: t.newton_iterations_per_call(),
+            mean_safe_region_width: t.mean_safe_width(),
+            isrt_early_outs: t.early_outs,
+            final_boxes: t.final_boxes,
+            cut_off_searches: t.cut_off,
+        }
+    }
 }
 
 /// Wall-clock seconds per phase.
