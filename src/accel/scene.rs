@@ -10,7 +10,9 @@ use glam::{DVec3, Vec3};
 use super::bvh::{Bvh, GeometryHasher};
 use crate::geom::{Aabb, BezierPatch, DAabb, Ray};
 use crate::kernel::subdivision::{self, PreparedPatch, SubdivisionConfig};
-use crate::kernel::triangle::{self, RayShear, TriangleHit};
+use crate::kernel::triangle::{
+    self, PACK_WIDTH, PackShear, RayShear, TriangleHit, TrianglePack, intersect_pack,
+};
 use crate::kernel::{KernelStats, PatchHit};
 use crate::scene::{Geometry, Scene};
 
@@ -69,6 +71,64 @@ struct Triangles {
     ids: Vec<(u32, u32)>,
 }
 
+/// The triangles again in BVH leaf order, four to a [`TrianglePack`], so that a leaf's
+/// triangles are one contiguous run tested four at a time with no index indirection.
+struct LeafPacks {
+    packs: Vec<TrianglePack>,
+    /// Triangle number (into [`Triangles`]) of each lane of each pack.
+    lanes: Vec<[u32; PACK_WIDTH]>,
+    /// For the first position of each leaf's range in the BVH's primitive index array, and
+    /// for the array's length, the index of the leaf's first pack: a leaf covering positions
+    /// `a..b` has packs `start[a]..start[b]` (leaves tile the positions).
+    start: Vec<u32>,
+}
+
+impl LeafPacks {
+    fn new(bvh: &Bvh, patches: u32, corners: &[[Vec3; 3]]) -> LeafPacks {
+        let mut leaves: Vec<(usize, usize)> = bvh
+            .nodes()
+            .iter()
+            .filter(|n| n.is_leaf())
+            .map(|n| (n.first as usize, n.count as usize))
+            .collect();
+        leaves.sort_unstable();
+        let mut p = LeafPacks {
+            packs: Vec::with_capacity(corners.len() / PACK_WIDTH + leaves.len()),
+            lanes: Vec::new(),
+            start: vec![0; bvh.prim_count() + 1],
+        };
+        let mut tris = Vec::with_capacity(PACK_WIDTH);
+        for (first, count) in leaves {
+            p.start[first] = p.packs.len() as u32;
+            let in_leaf = &bvh.prim_indices()[first..first + count];
+            let triangles: Vec<u32> = in_leaf
+                .iter()
+                .filter(|&&prim| prim >= patches)
+                .map(|&prim| prim - patches)
+                .collect();
+            for chunk in triangles.chunks(PACK_WIDTH) {
+                tris.clear();
+                tris.extend(chunk.iter().map(|&k| corners[k as usize]));
+                p.packs.push(TrianglePack::new(&tris));
+                let mut lanes = [u32::MAX; PACK_WIDTH];
+                lanes[..chunk.len()].copy_from_slice(chunk);
+                p.lanes.push(lanes);
+            }
+        }
+        p.start[bvh.prim_count()] = p.packs.len() as u32;
+        p
+    }
+
+    /// The packs of the leaf covering `range` and their first pack's index.
+    fn of_leaf(&self, range: &std::ops::Range<usize>) -> (usize, &[TrianglePack]) {
+        let (a, b) = (
+            self.start[range.start] as usize,
+            self.start[range.end] as usize,
+        );
+        (a, &self.packs[a..b])
+    }
+}
+
 /// The nearest candidate found so far during traversal.
 enum Candidate {
     Patch(u32, PatchHit),
@@ -82,6 +142,7 @@ pub struct SceneGeometry {
     /// (object, patch within object) per patch.
     ids: Vec<(u32, u32)>,
     triangles: Triangles,
+    leaf_packs: LeafPacks,
     bvh: Bvh,
 }
 
@@ -111,11 +172,13 @@ impl SceneGeometry {
         bvh: Bvh,
     ) -> SceneGeometry {
         let prepared = originals.iter().map(PreparedPatch::new).collect();
+        let leaf_packs = LeafPacks::new(&bvh, originals.len() as u32, &triangles.corners);
         SceneGeometry {
             prepared,
             originals,
             ids,
             triangles,
+            leaf_packs,
             bvh,
         }
     }
@@ -166,23 +229,39 @@ impl SceneGeometry {
     ) -> Option<SceneHit> {
         let mut best: Option<Candidate> = None;
         let mut kernel = KernelStats::default();
-        let shear = RayShear::new(ray);
+        let shear = PackShear::new(&RayShear::new(ray));
         let patches = self.prepared.len() as u32;
-        let t = self.bvh.traverse(ray, |prim, tmax| {
-            kernel.patch_tests += (prim >= patches) as u64;
-            if prim < patches {
-                let r = Ray { tmax, ..*ray };
-                let hit =
-                    subdivision::intersect(&self.prepared[prim as usize], &r, cfg, &mut kernel)?;
-                best = Some(Candidate::Patch(prim, hit));
-                Some(hit.t)
-            } else {
-                let k = prim - patches;
-                let [a, b, c] = self.triangles.corners[k as usize];
-                let hit = triangle::intersect_triangle(&shear, a, b, c, ray.tmin, tmax)?;
-                best = Some(Candidate::Triangle(k, hit));
-                Some(hit.t)
+        let t = self.bvh.traverse_leaves(ray, |range, tmax| {
+            // Patches of the leaf one at a time, then its triangles a pack at a time.
+            if patches > 0 {
+                for &prim in &self.bvh.prim_indices()[range.clone()] {
+                    if prim >= patches {
+                        continue;
+                    }
+                    let r = Ray {
+                        tmax: *tmax,
+                        ..*ray
+                    };
+                    let prepared = &self.prepared[prim as usize];
+                    if let Some(hit) = subdivision::intersect(prepared, &r, cfg, &mut kernel) {
+                        *tmax = tmax.min(hit.t);
+                        best = Some(Candidate::Patch(prim, hit));
+                    }
+                }
             }
+            let (first, packs) = self.leaf_packs.of_leaf(&range);
+            for (i, pack) in packs.iter().enumerate() {
+                kernel.patch_tests += 1;
+                let hits = intersect_pack(&shear, pack, ray.tmin, *tmax);
+                if hits.mask == 0 {
+                    continue;
+                }
+                if let Some((lane, hit)) = hits.nearest(tmax) {
+                    let k = self.leaf_packs.lanes[first + i][lane];
+                    best = Some(Candidate::Triangle(k, hit));
+                }
+            }
+            std::ops::ControlFlow::Continue(())
         });
         stats.kernel.add(&kernel);
         stats.nodes_visited += t.nodes_visited;
@@ -255,14 +334,25 @@ impl SceneGeometry {
             Precision::F32(cfg) => {
                 let mut kernel = KernelStats::default();
                 let patches = self.prepared.len() as u32;
-                let shear = RayShear::new(ray);
-                let (hit, t) = self.bvh.traverse_any(ray, |prim| {
-                    if prim < patches {
-                        subdivision::occluded(&self.prepared[prim as usize], ray, cfg, &mut kernel)
-                    } else {
+                let shear = PackShear::new(&RayShear::new(ray));
+                let mut hit = false;
+                let t = self.bvh.traverse_leaves(ray, |range, _| {
+                    hit = self.bvh.prim_indices()[range.clone()].iter().any(|&prim| {
+                        prim < patches
+                            && subdivision::occluded(
+                                &self.prepared[prim as usize],
+                                ray,
+                                cfg,
+                                &mut kernel,
+                            )
+                    }) || self.leaf_packs.of_leaf(&range).1.iter().any(|pack| {
                         kernel.patch_tests += 1;
-                        let [a, b, c] = self.triangles.corners[(prim - patches) as usize];
-                        triangle::intersect_triangle(&shear, a, b, c, ray.tmin, ray.tmax).is_some()
+                        intersect_pack(&shear, pack, ray.tmin, ray.tmax).mask != 0
+                    });
+                    if hit {
+                        std::ops::ControlFlow::Break(())
+                    } else {
+                        std::ops::ControlFlow::Continue(())
                     }
                 });
                 stats.kernel.add(&kernel);
