@@ -4,7 +4,8 @@
 //! middle row) traced with the watertight triangle kernel. Camera of DESIGN.md's sample
 //! scene, 512², one ray per pixel; median of several runs after a warm-up.
 //!
-//! `cargo bench --bench primary`
+//! `cargo bench --bench primary`, or `cargo bench --bench primary -- triangles` (or
+//! `-- patches`) for one of the two.
 
 use std::path::Path;
 use std::time::Instant;
@@ -19,24 +20,38 @@ use patchtrace::tessellate::{TessellationMode, tessellate_scene};
 const RUNS: usize = 5;
 const SIZE: u32 = 512;
 
-/// Median seconds to trace `rays` through `geometry`, and the number of hits.
-fn time(geometry: &SceneGeometry, rays: &[Ray]) -> (f64, usize) {
+/// Seconds this thread has run on a CPU (Linux `/proc/thread-self/schedstat`, first field in
+/// ns), or `None` elsewhere. On a shared machine wall time counts the waits for a core too;
+/// "per core" throughput divides by this instead.
+fn cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    Some(s.split_whitespace().next()?.parse::<f64>().ok()? * 1e-9)
+}
+
+/// Median wall seconds and median on-CPU seconds (wall where unavailable) to trace `rays`
+/// through `geometry`, and the number of hits.
+fn time(geometry: &SceneGeometry, rays: &[Ray]) -> (f64, f64, usize) {
     let precision = Precision::F32(SubdivisionConfig::default());
-    let mut samples = Vec::new();
+    let (mut wall, mut cpu) = (Vec::new(), Vec::new());
     let mut hits = 0;
     for run in 0..=RUNS {
-        let start = Instant::now();
+        let (start, cpu_start) = (Instant::now(), cpu_seconds());
         let mut stats = QueryStats::default();
         hits = rays
             .iter()
             .filter(|r| geometry.intersect(r, &precision, &mut stats).is_some())
             .count();
+        let elapsed = start.elapsed().as_secs_f64();
         if run > 0 {
-            samples.push(start.elapsed().as_secs_f64());
+            wall.push(elapsed);
+            cpu.push(cpu_seconds().zip(cpu_start).map_or(elapsed, |(b, a)| b - a));
         }
     }
-    samples.sort_by(f64::total_cmp);
-    (samples[samples.len() / 2], hits)
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    (median(wall), median(cpu), hits)
 }
 
 fn main() {
@@ -59,24 +74,33 @@ fn main() {
         .map(|(x, y)| cam.ray(x, y))
         .collect();
 
-    let direct = SceneGeometry::build(&scene);
-    let (seconds, hits) = time(&direct, &rays);
-    println!(
-        "patches   {:>7} prims: {:.3} s, {:.2} M rays/s/core, {} hits, {:.3} M patch hits/s/core",
-        direct.patch_count(),
-        seconds,
-        rays.len() as f64 / seconds / 1e6,
-        hits,
-        hits as f64 / seconds / 1e6
-    );
+    let only = std::env::args().skip(1).find(|a| !a.starts_with('-'));
+    let run = |name: &str| only.as_deref().is_none_or(|o| o == name);
 
+    if run("patches") {
+        let direct = SceneGeometry::build(&scene);
+        let (wall, seconds, hits) = time(&direct, &rays);
+        println!(
+            "patches   {:>7} prims: {:.3} s wall, {:.3} s on CPU, {:.2} M rays/s/core, {} hits, {:.3} M patch hits/s/core",
+            direct.patch_count(),
+            wall,
+            seconds,
+            rays.len() as f64 / seconds / 1e6,
+            hits,
+            hits as f64 / seconds / 1e6
+        );
+    }
+    if !run("triangles") {
+        return;
+    }
     let (meshes, report) =
         tessellate_scene(&scene, TessellationMode::TrianglesPerPatch(4608)).expect("tessellate");
     let triangles = SceneGeometry::build(&meshes);
-    let (seconds, hits) = time(&triangles, &rays);
+    let (wall, seconds, hits) = time(&triangles, &rays);
     println!(
-        "triangles {:>7} prims: {:.3} s, {:.2} M rays/s/core, {} hits",
+        "triangles {:>7} prims: {:.3} s wall, {:.3} s on CPU, {:.2} M rays/s/core, {} hits",
         report.triangles,
+        wall,
         seconds,
         rays.len() as f64 / seconds / 1e6,
         hits

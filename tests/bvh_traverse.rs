@@ -37,7 +37,9 @@ fn nearest_hit_equals_brute_force() {
                 brute_nearest(&spheres, &ray),
                 "n = {n}, ray {ray:?}"
             );
-            assert!(stats.nodes_visited as usize <= bvh.node_count());
+            // Wide nodes and leaves are fewer than the binary nodes, but a one-leaf tree
+            // still gets a wide root above its leaf.
+            assert!(stats.nodes_visited as usize <= bvh.node_count() + 1);
             hits += usize::from(nearest.is_some());
         }
         assert!(

@@ -6,6 +6,8 @@
 //! `i - patch count` otherwise. One query answers "nearest hit" or "anything in the way"
 //! for a ray, counting the work it did.
 
+use std::ops::ControlFlow;
+
 use glam::{DVec3, Vec3};
 
 use super::bvh::{Bvh, GeometryHasher};
@@ -13,7 +15,9 @@ use super::grid::Grid;
 use crate::geom::{Aabb, BezierPatch, DAabb, Ray};
 use crate::kernel::subdivision::{self, PreparedPatch, SubdivisionConfig};
 use crate::kernel::toth::{self, TothConfig};
-use crate::kernel::triangle::{self, RayShear, TriangleHit};
+use crate::kernel::triangle::{
+    self, PACK_WIDTH, PackShear, RayShear, TriangleHit, TrianglePack, intersect_pack,
+};
 use crate::kernel::{KernelStats, PatchHit};
 use crate::scene::{Geometry, Scene};
 
@@ -78,6 +82,64 @@ struct Triangles {
     ids: Vec<(u32, u32)>,
 }
 
+/// The triangles again in BVH leaf order, four to a [`TrianglePack`], so that a leaf's
+/// triangles are one contiguous run tested four at a time with no index indirection.
+struct LeafPacks {
+    packs: Vec<TrianglePack>,
+    /// Triangle number (into [`Triangles`]) of each lane of each pack.
+    lanes: Vec<[u32; PACK_WIDTH]>,
+    /// For the first position of each leaf's range in the BVH's primitive index array, and
+    /// for the array's length, the index of the leaf's first pack: a leaf covering positions
+    /// `a..b` has packs `start[a]..start[b]` (leaves tile the positions).
+    start: Vec<u32>,
+}
+
+impl LeafPacks {
+    fn new(bvh: &Bvh, patches: u32, corners: &[[Vec3; 3]]) -> LeafPacks {
+        let mut leaves: Vec<(usize, usize)> = bvh
+            .nodes()
+            .iter()
+            .filter(|n| n.is_leaf())
+            .map(|n| (n.first as usize, n.count as usize))
+            .collect();
+        leaves.sort_unstable();
+        let mut p = LeafPacks {
+            packs: Vec::with_capacity(corners.len() / PACK_WIDTH + leaves.len()),
+            lanes: Vec::new(),
+            start: vec![0; bvh.prim_count() + 1],
+        };
+        let mut tris = Vec::with_capacity(PACK_WIDTH);
+        for (first, count) in leaves {
+            p.start[first] = p.packs.len() as u32;
+            let in_leaf = &bvh.prim_indices()[first..first + count];
+            let triangles: Vec<u32> = in_leaf
+                .iter()
+                .filter(|&&prim| prim >= patches)
+                .map(|&prim| prim - patches)
+                .collect();
+            for chunk in triangles.chunks(PACK_WIDTH) {
+                tris.clear();
+                tris.extend(chunk.iter().map(|&k| corners[k as usize]));
+                p.packs.push(TrianglePack::new(&tris));
+                let mut lanes = [u32::MAX; PACK_WIDTH];
+                lanes[..chunk.len()].copy_from_slice(chunk);
+                p.lanes.push(lanes);
+            }
+        }
+        p.start[bvh.prim_count()] = p.packs.len() as u32;
+        p
+    }
+
+    /// The packs of the leaf covering `range` and their first pack's index.
+    fn of_leaf(&self, range: &std::ops::Range<usize>) -> (usize, &[TrianglePack]) {
+        let (a, b) = (
+            self.start[range.start] as usize,
+            self.start[range.end] as usize,
+        );
+        (a, &self.packs[a..b])
+    }
+}
+
 /// The nearest candidate found so far during traversal.
 enum Candidate {
     Patch(u32, PatchHit),
@@ -86,8 +148,16 @@ enum Candidate {
 
 /// The acceleration structure over the primitives.
 enum Accel {
-    Bvh(Bvh),
+    /// The BVH, with the triangles again in its leaf order.
+    Bvh(Bvh, LeafPacks),
     Grid(Grid),
+}
+
+impl Accel {
+    fn bvh(bvh: Bvh, patches: usize, triangles: &Triangles) -> Accel {
+        let packs = LeafPacks::new(&bvh, patches as u32, &triangles.corners);
+        Accel::Bvh(bvh, packs)
+    }
 }
 
 /// Prepared geometry of a scene.
@@ -116,7 +186,10 @@ impl SceneGeometry {
             )
             .collect();
         let bvh = Bvh::build(&boxes);
-        Self::with_accel(originals, ids, triangles, Accel::Bvh(bvh))
+        {
+            let accel = Accel::bvh(bvh, originals.len(), &triangles);
+            Self::with_accel(originals, ids, triangles, accel)
+        }
     }
 
     /// Prepares the patches and builds the uniform grid of LG90 §3.1 within `budget_bytes`
@@ -153,7 +226,7 @@ impl SceneGeometry {
     /// The BVH, when the geometry was prepared with one.
     pub fn bvh(&self) -> Option<&Bvh> {
         match &self.accel {
-            Accel::Bvh(bvh) => Some(bvh),
+            Accel::Bvh(bvh, _) => Some(bvh),
             Accel::Grid(_) => None,
         }
     }
@@ -162,7 +235,7 @@ impl SceneGeometry {
     pub fn grid(&self) -> Option<&Grid> {
         match &self.accel {
             Accel::Grid(grid) => Some(grid),
-            Accel::Bvh(_) => None,
+            Accel::Bvh(..) => None,
         }
     }
 
@@ -176,53 +249,8 @@ impl SceneGeometry {
 
     pub fn bounds(&self) -> Aabb {
         match &self.accel {
-            Accel::Bvh(bvh) => bvh.bounds(),
+            Accel::Bvh(bvh, _) => bvh.bounds(),
             Accel::Grid(grid) => grid.bounds(),
-        }
-    }
-
-    /// Nearest-first traversal of the accelerator (see [`Bvh::traverse`] and
-    /// [`Grid::traverse`]), adding its work to `stats`.
-    fn traverse(
-        &self,
-        ray: &Ray,
-        hit: impl FnMut(u32, f32) -> Option<f32>,
-        stats: &mut QueryStats,
-    ) {
-        match &self.accel {
-            Accel::Bvh(bvh) => {
-                let t = bvh.traverse(ray, hit);
-                stats.nodes_visited += t.nodes_visited;
-                stats.bvh_box_tests += t.box_tests;
-            }
-            Accel::Grid(grid) => {
-                let g = grid.traverse(ray, hit);
-                stats.voxels_visited += g.voxels_visited;
-                stats.bvh_box_tests += g.box_tests;
-            }
-        }
-    }
-
-    /// Any-hit traversal of the accelerator, adding its work to `stats`.
-    fn traverse_any(
-        &self,
-        ray: &Ray,
-        hit: impl FnMut(u32) -> bool,
-        stats: &mut QueryStats,
-    ) -> bool {
-        match &self.accel {
-            Accel::Bvh(bvh) => {
-                let (found, t) = bvh.traverse_any(ray, hit);
-                stats.nodes_visited += t.nodes_visited;
-                stats.bvh_box_tests += t.box_tests;
-                found
-            }
-            Accel::Grid(grid) => {
-                let (found, g) = grid.traverse_any(ray, hit);
-                stats.voxels_visited += g.voxels_visited;
-                stats.bvh_box_tests += g.box_tests;
-                found
-            }
         }
     }
 
@@ -248,29 +276,13 @@ impl SceneGeometry {
         precision: &Precision,
         stats: &mut QueryStats,
     ) -> Option<SceneHit> {
-        let mut best: Option<Candidate> = None;
         let mut kernel = KernelStats::default();
-        let shear = RayShear::new(ray);
-        let patches = self.prepared.len() as u32;
-        self.traverse(
-            ray,
-            |prim, tmax| {
-                kernel.patch_tests += (prim >= patches) as u64;
-                if prim < patches {
-                    let r = Ray { tmax, ..*ray };
-                    let hit = self.patch_hit(prim, &r, precision, &mut kernel)?;
-                    best = Some(Candidate::Patch(prim, hit));
-                    Some(hit.t)
-                } else {
-                    let k = prim - patches;
-                    let [a, b, c] = self.triangles.corners[k as usize];
-                    let hit = triangle::intersect_triangle(&shear, a, b, c, ray.tmin, tmax)?;
-                    best = Some(Candidate::Triangle(k, hit));
-                    Some(hit.t)
-                }
-            },
-            stats,
-        );
+        let best = match &self.accel {
+            Accel::Bvh(bvh, packs) => {
+                self.nearest_in_bvh(bvh, packs, ray, precision, &mut kernel, stats)
+            }
+            Accel::Grid(grid) => self.nearest_in_grid(grid, ray, precision, &mut kernel, stats),
+        };
         stats.kernel.add(&kernel);
         Some(match best? {
             Candidate::Patch(prim, h) => {
@@ -339,27 +351,156 @@ impl SceneGeometry {
         match precision {
             Precision::F32(_) | Precision::Toth(_) => {
                 let mut kernel = KernelStats::default();
-                let patches = self.prepared.len() as u32;
-                let shear = RayShear::new(ray);
-                let hit = self.traverse_any(
-                    ray,
-                    |prim| {
-                        if prim < patches {
-                            self.patch_occluded(prim, ray, precision, &mut kernel)
-                        } else {
-                            kernel.patch_tests += 1;
-                            let [a, b, c] = self.triangles.corners[(prim - patches) as usize];
-                            triangle::intersect_triangle(&shear, a, b, c, ray.tmin, ray.tmax)
-                                .is_some()
-                        }
-                    },
-                    stats,
-                );
+                let hit = match &self.accel {
+                    Accel::Bvh(bvh, packs) => {
+                        self.blocked_in_bvh(bvh, packs, ray, precision, &mut kernel, stats)
+                    }
+                    Accel::Grid(grid) => {
+                        self.blocked_in_grid(grid, ray, precision, &mut kernel, stats)
+                    }
+                };
                 stats.kernel.add(&kernel);
                 hit
             }
             Precision::F64(_) => self.intersect(ray, precision, stats).is_some(),
         }
+    }
+
+    /// The nearest candidate in the BVH: a leaf's patches one at a time, then its triangles
+    /// a pack at a time.
+    fn nearest_in_bvh(
+        &self,
+        bvh: &Bvh,
+        packs: &LeafPacks,
+        ray: &Ray,
+        precision: &Precision,
+        kernel: &mut KernelStats,
+        stats: &mut QueryStats,
+    ) -> Option<Candidate> {
+        let mut best = None;
+        let shear = PackShear::new(&RayShear::new(ray));
+        let patches = self.prepared.len() as u32;
+        let t = bvh.traverse_leaves(ray, |range, tmax| {
+            if patches > 0 {
+                for &prim in &bvh.prim_indices()[range.clone()] {
+                    if prim >= patches {
+                        continue;
+                    }
+                    let r = Ray {
+                        tmax: *tmax,
+                        ..*ray
+                    };
+                    if let Some(hit) = self.patch_hit(prim, &r, precision, kernel) {
+                        *tmax = tmax.min(hit.t);
+                        best = Some(Candidate::Patch(prim, hit));
+                    }
+                }
+            }
+            let (first, leaf_packs) = packs.of_leaf(&range);
+            for (i, pack) in leaf_packs.iter().enumerate() {
+                kernel.patch_tests += 1;
+                let hits = intersect_pack(&shear, pack, ray.tmin, *tmax);
+                if hits.mask == 0 {
+                    continue;
+                }
+                if let Some((lane, hit)) = hits.nearest(tmax) {
+                    best = Some(Candidate::Triangle(packs.lanes[first + i][lane], hit));
+                }
+            }
+            ControlFlow::Continue(())
+        });
+        stats.nodes_visited += t.nodes_visited;
+        stats.bvh_box_tests += t.box_tests;
+        best
+    }
+
+    /// Whether anything in the BVH blocks `ray`.
+    fn blocked_in_bvh(
+        &self,
+        bvh: &Bvh,
+        packs: &LeafPacks,
+        ray: &Ray,
+        precision: &Precision,
+        kernel: &mut KernelStats,
+        stats: &mut QueryStats,
+    ) -> bool {
+        let shear = PackShear::new(&RayShear::new(ray));
+        let patches = self.prepared.len() as u32;
+        let mut hit = false;
+        let t = bvh.traverse_leaves(ray, |range, _| {
+            hit = bvh.prim_indices()[range.clone()]
+                .iter()
+                .any(|&prim| prim < patches && self.patch_occluded(prim, ray, precision, kernel))
+                || packs.of_leaf(&range).1.iter().any(|pack| {
+                    kernel.patch_tests += 1;
+                    intersect_pack(&shear, pack, ray.tmin, ray.tmax).mask != 0
+                });
+            if hit {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        });
+        stats.nodes_visited += t.nodes_visited;
+        stats.bvh_box_tests += t.box_tests;
+        hit
+    }
+
+    /// The nearest candidate in the grid, one primitive at a time.
+    fn nearest_in_grid(
+        &self,
+        grid: &Grid,
+        ray: &Ray,
+        precision: &Precision,
+        kernel: &mut KernelStats,
+        stats: &mut QueryStats,
+    ) -> Option<Candidate> {
+        let mut best = None;
+        let shear = RayShear::new(ray);
+        let patches = self.prepared.len() as u32;
+        let g = grid.traverse(ray, |prim, tmax| {
+            kernel.patch_tests += (prim >= patches) as u64;
+            if prim < patches {
+                let r = Ray { tmax, ..*ray };
+                let hit = self.patch_hit(prim, &r, precision, kernel)?;
+                best = Some(Candidate::Patch(prim, hit));
+                Some(hit.t)
+            } else {
+                let k = prim - patches;
+                let [a, b, c] = self.triangles.corners[k as usize];
+                let hit = triangle::intersect_triangle(&shear, a, b, c, ray.tmin, tmax)?;
+                best = Some(Candidate::Triangle(k, hit));
+                Some(hit.t)
+            }
+        });
+        stats.voxels_visited += g.voxels_visited;
+        stats.bvh_box_tests += g.box_tests;
+        best
+    }
+
+    /// Whether anything in the grid blocks `ray`.
+    fn blocked_in_grid(
+        &self,
+        grid: &Grid,
+        ray: &Ray,
+        precision: &Precision,
+        kernel: &mut KernelStats,
+        stats: &mut QueryStats,
+    ) -> bool {
+        let shear = RayShear::new(ray);
+        let patches = self.prepared.len() as u32;
+        let (hit, g) = grid.traverse_any(ray, |prim| {
+            if prim < patches {
+                self.patch_occluded(prim, ray, precision, kernel)
+            } else {
+                kernel.patch_tests += 1;
+                let [a, b, c] = self.triangles.corners[(prim - patches) as usize];
+                triangle::intersect_triangle(&shear, a, b, c, ray.tmin, ray.tmax).is_some()
+            }
+        });
+        stats.voxels_visited += g.voxels_visited;
+        stats.bvh_box_tests += g.box_tests;
+        hit
     }
 
     /// Nearest hit on patch `prim` by the `f32`-ray kernel `precision` selects.
@@ -481,12 +622,15 @@ impl SceneGeometry {
                 "the BVH indexes a different number of patches than the scene; rebuild it with `patchtrace bvh`",
             ));
         }
-        Ok(Self::with_accel(originals, ids, triangles, Accel::Bvh(bvh)))
+        Ok({
+            let accel = Accel::bvh(bvh, originals.len(), &triangles);
+            Self::with_accel(originals, ids, triangles, accel)
+        })
     }
 
     /// Writes the BVH with the scene's geometry hash, atomically; refused for a grid.
     pub fn save_bvh(&self, path: &std::path::Path) -> Result<(), crate::scene::LoadError> {
-        let Accel::Bvh(bvh) = &self.accel else {
+        let Accel::Bvh(bvh, _) = &self.accel else {
             return Err(crate::scene::LoadError::invalid(
                 path,
                 "the geometry was prepared with a grid, which has no BVH to write",

@@ -7,7 +7,7 @@ use glam::{DVec3, Vec3, Vec3A};
 /// reciprocal once, so `t_far` is scaled by `1 + 2 γ(3)` with `γ(n) = n ε / (1 - n ε)`
 /// (Ize, "Robust BVH Ray Traversal", JCGT 2013; pbrt-v3 §3.9.2). This keeps a ray that grazes
 /// a box edge from slipping through between two adjacent boxes.
-const SLAB_FAR_SCALE: f32 = 1.0 + 2.0 * gamma3_f32();
+pub const SLAB_FAR_SCALE: f32 = 1.0 + 2.0 * gamma3_f32();
 
 /// The same bound for `f64`.
 const SLAB_FAR_SCALE_F64: f64 = 1.0 + 2.0 * gamma3_f64();

@@ -51,10 +51,7 @@ pub(super) fn build(boxes: &[Aabb]) -> Bvh {
         });
         builder.subdivide(0, 0, n, 0);
     }
-    Bvh {
-        nodes: builder.nodes,
-        prim_indices: builder.prims,
-    }
+    Bvh::with_wide(builder.nodes, builder.prims)
 }
 
 struct Builder<'a> {

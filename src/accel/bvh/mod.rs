@@ -5,8 +5,9 @@
 //!
 //! - [`build`](Bvh::build): top-down binned surface area heuristic (Wald, "On fast Construction
 //!   of SAH-based Bounding Volume Hierarchies", 2007) in place of Dammertz's median cut.
-//! - [`traverse`](Bvh::traverse) / [`traverse_any`](Bvh::traverse_any): stack-based,
-//!   nearest-entry child first, no allocation per ray.
+//! - [`traverse`](Bvh::traverse) / [`traverse_any`](Bvh::traverse_any) /
+//!   [`traverse_leaves`](Bvh::traverse_leaves): stack-based, nearest-entry child first, no
+//!   allocation per ray, over a 4-wide form of the tree derived on construction (`wide`).
 //! - [`write`](Bvh::write) / [`read`](Bvh::read): a versioned little-endian file with a
 //!   geometry hash ([`GeometryHasher`]) and a checksum, validated so that no file can make
 //!   traversal panic or loop.
@@ -15,6 +16,7 @@ mod build;
 mod file;
 mod hash;
 mod traverse;
+mod wide;
 
 pub use file::{BvhFileError, FORMAT_VERSION, MAGIC};
 pub use hash::GeometryHasher;
@@ -51,11 +53,13 @@ impl Node {
 }
 
 /// The hierarchy: nodes with the root at index 0 (no nodes for an empty scene) and the
-/// primitive indices the leaves point into, a permutation of `0..primitive count`.
+/// primitive indices the leaves point into, a permutation of `0..primitive count`. The wide
+/// form that traversal walks is derived from the nodes and never stored.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Bvh {
     nodes: Vec<Node>,
     prim_indices: Vec<u32>,
+    wide: Vec<wide::WideNode>,
 }
 
 impl Bvh {
@@ -67,12 +71,17 @@ impl Bvh {
     /// Assembles a tree from its arrays (from another builder or a file), refusing any that
     /// breaks the invariants traversal relies on; see [`BvhFileError::Invalid`].
     pub fn from_parts(nodes: Vec<Node>, prim_indices: Vec<u32>) -> Result<Bvh, BvhFileError> {
-        let bvh = Bvh {
+        Bvh::validate(&nodes, &prim_indices).map_err(BvhFileError::Invalid)?;
+        Ok(Bvh::with_wide(nodes, prim_indices))
+    }
+
+    /// The tree with its wide form; `nodes` must be valid.
+    fn with_wide(nodes: Vec<Node>, prim_indices: Vec<u32>) -> Bvh {
+        Bvh {
+            wide: wide::collapse(&nodes),
             nodes,
             prim_indices,
-        };
-        bvh.validate().map_err(BvhFileError::Invalid)?;
-        Ok(bvh)
+        }
     }
 
     /// The box of everything ([`Aabb::EMPTY`] for no primitives).
@@ -125,9 +134,9 @@ impl Bvh {
     /// Checks what traversal relies on: children after their parent and in range, every node
     /// but the root with exactly one parent, depth below [`MAX_DEPTH`], leaves in range of the
     /// index array, and the indices a permutation of `0..prim_count`.
-    fn validate(&self) -> Result<(), String> {
-        let n = self.nodes.len();
-        let prims = self.prim_indices.len();
+    fn validate(nodes: &[Node], prim_indices: &[u32]) -> Result<(), String> {
+        let n = nodes.len();
+        let prims = prim_indices.len();
         if n == 0 {
             return if prims == 0 {
                 Ok(())
@@ -138,7 +147,7 @@ impl Bvh {
         let mut depth = vec![0usize; n];
         let mut parents = vec![0u8; n];
         let mut covered = vec![false; prims];
-        for (i, node) in self.nodes.iter().enumerate() {
+        for (i, node) in nodes.iter().enumerate() {
             if parents[i] != u8::from(i != 0) {
                 return Err(format!(
                     "node {i} is not reached exactly once from the root"
@@ -154,7 +163,7 @@ impl Bvh {
                         "leaf {i} points past the {prims} primitive indices"
                     ));
                 };
-                for &p in &self.prim_indices[first..end] {
+                for &p in &prim_indices[first..end] {
                     match covered.get_mut(p as usize) {
                         Some(seen @ false) => *seen = true,
                         Some(true) => return Err(format!("primitive {p} is in two leaves")),

@@ -1,19 +1,68 @@
-//! Stack-based traversal, nearer child first (Dammertz §3.2): both child boxes are tested, the
-//! one the ray enters first is visited next and the other is pushed with its entry `t`, so
-//! that once a hit has shortened the ray, pushed subtrees beyond it are skipped unvisited.
+//! Stack-based traversal of the wide tree, nearer children first (Dammertz §3.2; Dammertz,
+//! Hanika and Keller 2008 §2.2): one SIMD slab test decides all four children of a node, the
+//! nearest child the ray enters is visited next and the others are pushed with their entry
+//! `t`, farthest first, so that once a hit has shortened the ray, pushed subtrees beyond it
+//! are skipped unvisited.
 
+use std::mem::MaybeUninit;
 use std::ops::ControlFlow;
 
+use glam::Vec4;
+
+use super::wide::{Child, WIDTH};
 use super::{Bvh, MAX_DEPTH};
 use crate::geom::Ray;
+use crate::geom::bbox::SLAB_FAR_SCALE;
 
 /// Work done by one traversal, for `--stats`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct TraversalStats {
-    /// Nodes whose contents were examined (inner nodes and leaves).
+    /// Nodes whose contents were examined (wide inner nodes and leaves).
     pub nodes_visited: u64,
-    /// Ray–box tests against node boxes.
+    /// Ray–box tests against node boxes (four per wide node, one SIMD test).
     pub box_tests: u64,
+}
+
+/// The ray in the form the 4-wide slab test wants: origin and reciprocal direction splat per
+/// axis, and per axis which box plane the ray meets first.
+struct WideRay {
+    origin: [Vec4; 3],
+    inv_dir: [Vec4; 3],
+    negative: [bool; 3],
+}
+
+impl WideRay {
+    fn new(ray: &Ray) -> WideRay {
+        let inv = ray.dir.recip();
+        WideRay {
+            origin: [0, 1, 2].map(|k| Vec4::splat(ray.origin[k])),
+            inv_dir: [0, 1, 2].map(|k| Vec4::splat(inv[k])),
+            // 1 / -0 is -inf: a ray with a -0 component counts as going down that axis.
+            negative: [0, 1, 2].map(|k| inv[k] < 0.0),
+        }
+    }
+
+    /// Entry and exit `t` of the four child boxes of `min`/`max`, clipped to `[tmin, tmax]`;
+    /// a lane is hit when entry <= exit. The robust slab test of [`crate::geom::bbox::slab`]
+    /// on four boxes: the near plane of each axis is picked by the direction's sign, so an
+    /// empty box (`min > max`) gives entry +inf and exit -inf. `0 * inf` (the origin on a
+    /// plane the ray runs in) gives NaN, and that slab must bound nothing: `a.max(b)` and
+    /// `a.min(b)` return `b` when `a` is NaN (SSE `maxps`/`minps`; `f32::max` ignores NaN
+    /// either way), so each chain starts from the slab values and ends in a number.
+    #[inline(always)]
+    fn slab4(&self, min: &[Vec4; 3], max: &[Vec4; 3], tmin: f32, tmax: f32) -> (Vec4, Vec4) {
+        let t = |k: usize, near: bool| {
+            let plane = if self.negative[k] == near {
+                max[k]
+            } else {
+                min[k]
+            };
+            (plane - self.origin[k]) * self.inv_dir[k]
+        };
+        let enter = t(0, true).max(t(1, true).max(t(2, true).max(Vec4::splat(tmin))));
+        let exit = t(0, false).min(t(1, false).min(t(2, false).min(Vec4::splat(f32::INFINITY))));
+        (enter, (exit * SLAB_FAR_SCALE).min(Vec4::splat(tmax)))
+    }
 }
 
 impl Bvh {
@@ -26,9 +75,11 @@ impl Bvh {
         ray: &Ray,
         mut hit: F,
     ) -> TraversalStats {
-        self.walk(ray, |prim, tmax| {
-            if let Some(t) = hit(prim, *tmax) {
-                *tmax = tmax.min(t);
+        self.traverse_leaves(ray, |range, tmax| {
+            for &prim in &self.prim_indices[range] {
+                if let Some(t) = hit(prim, *tmax) {
+                    *tmax = tmax.min(t);
+                }
             }
             ControlFlow::Continue(())
         })
@@ -42,8 +93,8 @@ impl Bvh {
         mut hit: F,
     ) -> (bool, TraversalStats) {
         let mut found = false;
-        let stats = self.walk(ray, |prim, _| {
-            if hit(prim) {
+        let stats = self.traverse_leaves(ray, |range, _| {
+            if self.prim_indices[range].iter().any(|&p| hit(p)) {
                 found = true;
                 ControlFlow::Break(())
             } else {
@@ -53,70 +104,80 @@ impl Bvh {
         (found, stats)
     }
 
-    /// The shared walk: `visit(prim, &mut tmax)` may shorten the ray or stop the walk.
+    /// The walk itself, a leaf at a time: `visit(range, &mut tmax)` gets the leaf's range of
+    /// [`prim_indices`](Bvh::prim_indices) (leaves own disjoint ranges, so callers can keep
+    /// per-leaf data in that order) and may shorten the ray or stop the walk. Leaves are
+    /// offered nearest entry first, and only while their entry is within `tmax`.
     #[inline(always)]
-    fn walk<F>(&self, ray: &Ray, mut visit: F) -> TraversalStats
+    pub fn traverse_leaves<F>(&self, ray: &Ray, mut visit: F) -> TraversalStats
     where
-        F: FnMut(u32, &mut f32) -> ControlFlow<()>,
+        F: FnMut(std::ops::Range<usize>, &mut f32) -> ControlFlow<()>,
     {
         let mut stats = TraversalStats::default();
-        let Some(root) = self.nodes.first() else {
-            return stats;
-        };
-        let origin = ray.origin;
-        let inv_dir = ray.dir.recip();
-        let tmin = ray.tmin;
-        let mut tmax = ray.tmax;
-        stats.box_tests += 1;
-        if root.bounds.intersect(origin, inv_dir, tmin, tmax).is_none() {
+        if self.wide.is_empty() {
             return stats;
         }
-        // At most one push per level (the far child), so MAX_DEPTH entries suffice: the builder
-        // and `validate` keep every node above that depth.
-        let mut stack = [(0u32, 0.0f32); MAX_DEPTH];
+        let wray = WideRay::new(ray);
+        let tmin = ray.tmin;
+        let mut tmax = ray.tmax;
+        // Each wide level pushes at most WIDTH - 1 entries and the wide tree is no deeper
+        // than the binary one, which the builder and `validate` keep below MAX_DEPTH. Left
+        // uninitialised: zeroing its 1.5 KB was two thirds of the instructions per ray
+        // (callgrind, BENCHMARKS.md issue 4).
+        let mut stack = [MaybeUninit::<(Child, f32)>::uninit(); (WIDTH - 1) * MAX_DEPTH];
         let mut top = 0;
-        let mut node = 0usize;
+        let mut current = Child { index: 0, count: 0 };
         loop {
             stats.nodes_visited += 1;
-            let n = &self.nodes[node];
-            let first = n.first as usize;
             let mut next = None;
-            if n.is_leaf() {
-                for &prim in &self.prim_indices[first..first + n.count as usize] {
-                    if visit(prim, &mut tmax).is_break() {
-                        return stats;
-                    }
+            if current.count > 0 {
+                let first = current.index as usize;
+                let range = first..first + current.count as usize;
+                if visit(range, &mut tmax).is_break() {
+                    return stats;
                 }
             } else {
-                stats.box_tests += 2;
-                let hit = |i: usize| self.nodes[i].bounds.intersect(origin, inv_dir, tmin, tmax);
-                next = match (hit(first), hit(first + 1)) {
-                    (Some((ta, _)), Some((tb, _))) => {
-                        let (near, far, t_far) = if tb < ta {
-                            (first + 1, first, ta)
-                        } else {
-                            (first, first + 1, tb)
-                        };
-                        stack[top] = (far as u32, t_far);
-                        top += 1;
-                        Some(near)
+                let node = &self.wide[current.index as usize];
+                stats.box_tests += WIDTH as u64;
+                let (enter, exit) = wray.slab4(&node.min, &node.max, tmin, tmax);
+                let mut mask = enter.cmple(exit).bitmask();
+                // Push the hit children farthest first so the nearest is popped next; the
+                // nearest of all is visited straight away.
+                let mut hits = [(Child { index: 0, count: 0 }, 0.0f32); WIDTH];
+                let mut n = 0;
+                while mask != 0 {
+                    let lane = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let entry = (node.children[lane], enter[lane]);
+                    // Insertion sort by decreasing entry t: at most four elements.
+                    let mut i = n;
+                    while i > 0 && hits[i - 1].1 < entry.1 {
+                        hits[i] = hits[i - 1];
+                        i -= 1;
                     }
-                    (Some(_), None) => Some(first),
-                    (None, Some(_)) => Some(first + 1),
-                    (None, None) => None,
-                };
+                    hits[i] = entry;
+                    n += 1;
+                }
+                if n > 0 {
+                    for &entry in &hits[..n - 1] {
+                        stack[top].write(entry);
+                        top += 1;
+                    }
+                    next = Some(hits[n - 1].0);
+                }
             }
-            node = match next {
+            current = match next {
                 Some(child) => child,
                 None => loop {
                     if top == 0 {
                         return stats;
                     }
                     top -= 1;
-                    let (pushed, t_enter) = stack[top];
+                    // SAFETY: entries below `top` were written by the pushes above.
+                    let (pushed, t_enter) = unsafe { stack[top].assume_init() };
                     // Skip subtrees that start beyond a hit found since they were pushed.
                     if t_enter <= tmax {
-                        break pushed as usize;
+                        break pushed;
                     }
                 },
             };
