@@ -23,6 +23,17 @@ pub enum Precision {
     F64(SubdivisionConfig),
 }
 
+impl Precision {
+    /// The path for secondary rays: the same, with adaptive termination (defined by the
+    /// camera's pixels) replaced by float precision.
+    pub fn for_secondary_rays(self) -> Precision {
+        match self {
+            Precision::F32(cfg) => Precision::F32(cfg.for_secondary_rays()),
+            Precision::F64(cfg) => Precision::F64(cfg.for_secondary_rays()),
+        }
+    }
+}
+
 /// Work done by one query.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct QueryStats {

@@ -49,11 +49,12 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     args.size.apply(&mut scene.camera)?;
     let plan = EffectPlan::for_scene(scene);
     eprintln!("{plan}");
+    let precision = precision(&args.kernel, &scene.camera);
     let integrator = Integrator {
         scene,
         geometry: &prepared.geometry,
         settings: TraceSettings {
-            precision: precision(&args.kernel),
+            precision,
             ulps: args.ulps,
             plan,
         },

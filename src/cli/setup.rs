@@ -7,17 +7,28 @@ use std::time::Instant;
 use anyhow::Context;
 
 use crate::accel::scene::{Precision, SceneGeometry};
-use crate::cli::args::{HeuristicChoice, KernelArgs, KernelChoice, PrecisionChoice};
-use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig};
-use crate::scene::{Scene, load_scene};
+use crate::cli::args::{
+    HeuristicChoice, KernelArgs, KernelChoice, PrecisionChoice, TerminationChoice,
+};
+use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig, Termination};
+use crate::render::camera::CameraRays;
+use crate::scene::{Camera, Scene, load_scene};
 
-/// The kernel path selected by the flags.
-pub fn precision(args: &KernelArgs) -> Precision {
+/// The kernel path selected by the flags; `camera` sizes the pixels of adaptive
+/// termination.
+pub fn precision(args: &KernelArgs, camera: &Camera) -> Precision {
     let KernelChoice::Subdivision = args.kernel;
     let mut cfg = SubdivisionConfig {
         heuristic: match args.heuristic {
             HeuristicChoice::Length => SplitHeuristic::Length,
             HeuristicChoice::Cross => SplitHeuristic::CrossProduct,
+        },
+        termination: match args.termination {
+            TerminationChoice::Float => Termination::Float,
+            TerminationChoice::Depth(d) => Termination::Depth(d),
+            TerminationChoice::Adaptive => {
+                Termination::Adaptive(CameraRays::new(camera).footprint())
+            }
         },
         ..SubdivisionConfig::default()
     };

@@ -22,7 +22,7 @@ pub fn run(args: TraceArgs) -> anyhow::Result<ExitCode> {
     let src = read_text(&args.rays)?;
     let rays = parse_rays(&args.rays, &src)?;
     let prepared = prepare(&args.scene, &args.kernel)?;
-    let precision = precision(&args.kernel);
+    let precision = precision(&args.kernel, &prepared.scene.camera);
     let pool = thread_pool(args.threads)?;
     let rows: Vec<String> = pool.install(|| {
         rays.par_iter()
