@@ -32,6 +32,18 @@ pub enum Precision {
     Toth(TothConfig),
 }
 
+impl Precision {
+    /// The path for secondary rays: the same, with adaptive termination (defined by the
+    /// camera's pixels) replaced by float precision.
+    pub fn for_secondary_rays(self) -> Precision {
+        match self {
+            Precision::F32(cfg) => Precision::F32(cfg.for_secondary_rays()),
+            Precision::F64(cfg) => Precision::F64(cfg.for_secondary_rays()),
+            Precision::Toth(cfg) => Precision::Toth(cfg),
+        }
+    }
+}
+
 /// Work done by one query.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct QueryStats {

@@ -160,6 +160,43 @@ pub enum HeuristicChoice {
     Cross,
 }
 
+/// Termination criterion of the subdivision kernel, as `--termination` reads it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TerminationChoice {
+    /// `float`: subdivide until the box stops shrinking (Dammertz §2.3.3).
+    Float,
+    /// `depth:N`: stop after N splits in total (u and v together).
+    Depth(u8),
+    /// `adaptive`: stop when the box projects below half a pixel (Dammertz §2.5.3).
+    Adaptive,
+}
+
+impl std::str::FromStr for TerminationChoice {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "float" => Ok(TerminationChoice::Float),
+            "adaptive" => Ok(TerminationChoice::Adaptive),
+            _ => {
+                let n = s
+                    .strip_prefix("depth:")
+                    .ok_or_else(|| format!("expected float, adaptive or depth:N, found `{s}`"))?;
+                match n.parse::<u8>() {
+                    Ok(d) if (1..=MAX_DEPTH).contains(&d) => Ok(TerminationChoice::Depth(d)),
+                    _ => Err(format!(
+                        "depth:N needs N from 1 to {MAX_DEPTH}, found `{n}`"
+                    )),
+                }
+            }
+        }
+    }
+}
+
+/// The deepest `--termination depth:N`: 2 × 32 splits is as far as the `f32` kernel's
+/// parameter cells go per direction (`kernel::subdivision::param`).
+pub const MAX_DEPTH: u8 = 64;
+
 /// Options shared by every command that intersects rays.
 #[derive(Debug, Args, Clone)]
 pub struct KernelArgs {
@@ -172,6 +209,14 @@ pub struct KernelArgs {
     /// Split direction heuristic.
     #[arg(long, value_enum, default_value_t = HeuristicChoice::Length)]
     pub heuristic: HeuristicChoice,
+    /// When the subdivision stops: `float` (default) until the box stops shrinking in the
+    /// kernel's float type (Dammertz §2.3.3); `depth:N` after N splits in total, u and v
+    /// together (the recursion depth of Dammertz's algorithm 2.2.1), or earlier if the box
+    /// stops shrinking; `adaptive` when the box projects below half a pixel of the scene
+    /// camera (Dammertz §2.5.3). Adaptive applies to primary rays: render uses float
+    /// precision for secondary rays, and trace treats every ray as starting at the camera.
+    #[arg(long, value_name = "float|depth:N|adaptive", default_value = "float")]
+    pub termination: TerminationChoice,
     /// Mantissa distance (ulps) at which subdivision of rational patches stops
     /// (Dammertz §2.7.2).
     #[arg(long, value_name = "ULPS")]
@@ -335,7 +380,7 @@ pub struct CompareArgs {
     /// Scene (.ron) or bare geometry.
     pub scene: PathBuf,
     /// Triangles per patch of each tessellation to compare (even counts 2·u·v).
-    #[arg(long, value_delimiter = ',', default_values_t = [512u32, 4608, 131072])]
+    #[arg(long, value_delimiter = ',', default_values_t = crate::bench::accuracy::DEFAULT_TRIANGLES)]
     pub triangles: Vec<u32>,
     /// Directory for the images, heat maps and the table (created if missing).
     #[arg(long, default_value = "compare-out")]
@@ -361,10 +406,17 @@ pub struct AccuracyArgs {
     /// Trace an N×N image of camera rays instead of the camera's own size.
     #[arg(long, value_name = "N")]
     pub size: Option<u32>,
+    /// Depths (total splits) of the fixed-depth rows.
+    #[arg(long, value_delimiter = ',', default_values_t = crate::bench::accuracy::DEFAULT_DEPTHS)]
+    pub depths: Vec<u8>,
+    /// Mantissa distances (ulps) of the rational-dist rows (Dammertz Table 2.12); only run
+    /// when the scene has rational patches.
+    #[arg(long, value_delimiter = ',', default_values_t = crate::bench::accuracy::DEFAULT_DISTS)]
+    pub dists: Vec<u32>,
     /// Triangles per patch of the tessellated methods.
-    #[arg(long, value_delimiter = ',', default_values_t = [512u32, 4608, 131072])]
+    #[arg(long, value_delimiter = ',', default_values_t = crate::bench::accuracy::DEFAULT_TRIANGLES)]
     pub triangles: Vec<u32>,
-    /// Directory for accuracy.md, accuracy.csv and accuracy.svg.
+    /// Directory for accuracy.md, accuracy.csv, accuracy.svg and accuracy.png.
     #[arg(long, default_value = "bench-out")]
     pub out_dir: PathBuf,
     /// Print the results as JSON instead of a table.
@@ -396,5 +448,22 @@ impl ImageSizeArgs {
         camera.width = self.width.unwrap_or(camera.width);
         camera.height = self.height.unwrap_or(camera.height);
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn termination_values_parse_and_bad_ones_are_refused() {
+        let parse = |s: &str| s.parse::<TerminationChoice>();
+        assert_eq!(parse("float"), Ok(TerminationChoice::Float));
+        assert_eq!(parse("adaptive"), Ok(TerminationChoice::Adaptive));
+        assert_eq!(parse("depth:12"), Ok(TerminationChoice::Depth(12)));
+        assert_eq!(parse("depth:64"), Ok(TerminationChoice::Depth(MAX_DEPTH)));
+        for bad in ["depth:0", "depth:65", "depth:", "depth:x", "fixed", ""] {
+            assert!(parse(bad).is_err(), "{bad} accepted");
+        }
     }
 }

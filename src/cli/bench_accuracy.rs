@@ -7,7 +7,6 @@ use anyhow::Context;
 
 use crate::bench::accuracy::{self, Method, plot};
 use crate::cli::args::AccuracyArgs;
-use crate::kernel::subdivision::SplitHeuristic;
 use crate::render::camera::CameraRays;
 use crate::scene::error::read_text;
 use crate::scene::load_scene;
@@ -40,11 +39,13 @@ pub fn run(args: AccuracyArgs) -> anyhow::Result<ExitCode> {
                 .collect()
         }
     };
-    let mut methods = vec![
-        Method::Float(SplitHeuristic::Length),
-        Method::Float(SplitHeuristic::CrossProduct),
-    ];
-    methods.extend(args.triangles.iter().map(|&n| Method::Tessellated(n)));
+    let rational = scene
+        .objects
+        .iter()
+        .flat_map(|o| o.bezier_patches())
+        .any(|p| p.is_rational());
+    let dists: &[u32] = if rational { &args.dists } else { &[] };
+    let methods = Method::list(&args.depths, dists, &args.triangles);
     let quiet = args.quiet;
     let results = accuracy::run(&scene, &rays, &methods, |what| {
         if !quiet {
@@ -57,12 +58,14 @@ pub fn run(args: AccuracyArgs) -> anyhow::Result<ExitCode> {
     let table = accuracy::markdown(&results);
     let title = format!("{}: error against time per ray", args.scene.display());
     let svg = plot::svg(&results, &title).map_err(|e| anyhow::anyhow!("drawing the plot: {e}"))?;
-    for (name, text) in [
-        ("accuracy.md", &table),
-        ("accuracy.csv", &accuracy::csv(&results)),
-        ("accuracy.svg", &svg),
+    let png = plot::png(&results, &title).map_err(|e| anyhow::anyhow!("drawing the plot: {e}"))?;
+    for (name, bytes) in [
+        ("accuracy.md", table.as_bytes()),
+        ("accuracy.csv", accuracy::csv(&results).as_bytes()),
+        ("accuracy.svg", svg.as_bytes()),
+        ("accuracy.png", &png),
     ] {
-        write_atomic(&args.out_dir.join(name), |w| w.write_all(text.as_bytes()))?;
+        write_atomic(&args.out_dir.join(name), |w| w.write_all(bytes))?;
     }
     let mut out = std::io::stdout().lock();
     if args.json {
@@ -72,7 +75,7 @@ pub fn run(args: AccuracyArgs) -> anyhow::Result<ExitCode> {
     }
     if !quiet {
         eprintln!(
-            "wrote accuracy.md, accuracy.csv and accuracy.svg to {}",
+            "wrote accuracy.md, accuracy.csv, accuracy.svg and accuracy.png to {}",
             args.out_dir.display()
         );
     }

@@ -43,11 +43,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
             .into());
         }
     }
-    let precision = precision(&args.kernel)?;
     let pool = thread_pool(args.threads)?;
     let mut prepared = prepare(&args.scene, &args.kernel)?;
     let scene = &mut prepared.scene;
     args.size.apply(&mut scene.camera)?;
+    let precision = precision(&args.kernel, &scene.camera)?;
     let plan = EffectPlan::for_scene(scene);
     eprintln!("{plan}");
     let integrator = Integrator {

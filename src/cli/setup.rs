@@ -7,13 +7,17 @@ use std::time::Instant;
 use anyhow::Context;
 
 use crate::accel::scene::{Precision, SceneGeometry};
-use crate::cli::args::{AccelChoice, HeuristicChoice, KernelArgs, KernelChoice, PrecisionChoice};
-use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig};
+use crate::cli::args::{
+    AccelChoice, HeuristicChoice, KernelArgs, KernelChoice, PrecisionChoice, TerminationChoice,
+};
+use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig, Termination};
 use crate::kernel::toth::TothConfig;
-use crate::scene::{Scene, load_scene};
+use crate::render::camera::CameraRays;
+use crate::scene::{Camera, Scene, load_scene};
 
-/// The kernel path selected by the flags, or why the flags do not go together.
-pub fn precision(args: &KernelArgs) -> anyhow::Result<Precision> {
+/// The kernel path selected by the flags, or why the flags do not go together; `camera`
+/// sizes the pixels of adaptive termination.
+pub fn precision(args: &KernelArgs, camera: &Camera) -> anyhow::Result<Precision> {
     if args.kernel == KernelChoice::Toth {
         anyhow::ensure!(
             args.precision == PrecisionChoice::F32,
@@ -32,6 +36,13 @@ pub fn precision(args: &KernelArgs) -> anyhow::Result<Precision> {
         heuristic: match args.heuristic {
             HeuristicChoice::Length => SplitHeuristic::Length,
             HeuristicChoice::Cross => SplitHeuristic::CrossProduct,
+        },
+        termination: match args.termination {
+            TerminationChoice::Float => Termination::Float,
+            TerminationChoice::Depth(d) => Termination::Depth(d),
+            TerminationChoice::Adaptive => {
+                Termination::Adaptive(CameraRays::new(camera).footprint())
+            }
         },
         ..SubdivisionConfig::default()
     };

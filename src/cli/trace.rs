@@ -19,10 +19,10 @@ use crate::scene::write::write_atomic;
 pub const TRACE_HEADER: &str = "ray,hit,t,object,patch,u,v,px,py,pz,nx,ny,nz";
 
 pub fn run(args: TraceArgs) -> anyhow::Result<ExitCode> {
-    let precision = precision(&args.kernel)?;
     let src = read_text(&args.rays)?;
     let rays = parse_rays(&args.rays, &src)?;
     let prepared = prepare(&args.scene, &args.kernel)?;
+    let precision = precision(&args.kernel, &prepared.scene.camera)?;
     let pool = thread_pool(args.threads)?;
     let rows: Vec<String> = pool.install(|| {
         rays.par_iter()

@@ -4,6 +4,7 @@
 use glam::{DVec3, Vec3};
 
 use crate::geom::Ray;
+use crate::kernel::subdivision::ScreenFootprint;
 use crate::scene::Camera;
 
 /// The camera's orthonormal frame and image-plane scale, precomputed.
@@ -52,6 +53,16 @@ impl CameraRays {
 
     pub fn eye(&self) -> Vec3 {
         self.eye.as_vec3()
+    }
+
+    /// What adaptive termination (Dammertz §2.5.3) needs: the view direction and half a
+    /// pixel's edge on the image plane at distance 1 (pixels are square: `2 s / height`
+    /// wide and high).
+    pub fn footprint(&self) -> ScreenFootprint {
+        ScreenFootprint {
+            forward: self.forward.as_vec3().to_array(),
+            half_pixel: (self.scale / self.height) as f32,
+        }
     }
 }
 

@@ -41,9 +41,11 @@ impl Integrator<'_> {
     /// and whether it hit anything.
     fn radiance(&self, ray: &Ray, kind: RayKind, depth: u32, tally: &mut RayTally) -> (Vec3, bool) {
         let mut q = QueryStats::default();
-        let hit = self
-            .geometry
-            .intersect(ray, &self.settings.precision, &mut q);
+        let precision = match kind {
+            RayKind::Primary => self.settings.precision,
+            _ => self.settings.precision.for_secondary_rays(),
+        };
+        let hit = self.geometry.intersect(ray, &precision, &mut q);
         tally.record(kind, &q);
         let Some(hit) = hit else {
             return (self.scene.background, false);
@@ -94,9 +96,9 @@ impl Integrator<'_> {
                     tmax,
                 };
                 let mut q = QueryStats::default();
-                let blocked = self
-                    .geometry
-                    .occluded(&shadow, &self.settings.precision, &mut q);
+                let blocked =
+                    self.geometry
+                        .occluded(&shadow, &precision.for_secondary_rays(), &mut q);
                 tally.record(RayKind::Shadow, &q);
                 if blocked {
                     continue;

@@ -1,5 +1,6 @@
 //! `bench accuracy`: what accuracy costs in time. Every method traces the same rays (the
-//! camera's primary rays, or a ray file) and is compared with the `f64` reference path
+//! camera's primary rays, or a ray file, rounded once to `f32`) and is compared with the
+//! `f64` reference path on those rays
 //! (the same subdivision algorithm in `f64`): hit-point and normal error (L1, as Dammertz
 //! Tables 2.1–2.4, and relative to the hit's coordinate magnitude), holes and false hits,
 //! time per ray (median of several single-threaded runs after a warm-up) and memory.
@@ -14,10 +15,11 @@ use glam::DVec3;
 use serde::Serialize;
 
 use crate::accel::scene::{Precision, QueryStats, SceneGeometry, SceneHit};
-use crate::geom::Ray;
-use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig};
-use crate::scene::Scene;
+use crate::geom::{DAabb, Ray};
+use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig, Termination};
+use crate::render::camera::CameraRays;
 use crate::scene::rays::RayQuery;
+use crate::scene::{Camera, Scene};
 use crate::tessellate::{TessellationMode, TessellationReport, tessellate_scene};
 
 /// Timed runs per method after one warm-up run; the median is reported.
@@ -26,8 +28,16 @@ pub const TIMED_RUNS: usize = 3;
 /// A way of intersecting rays with the scene.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Method {
-    /// The float-precision subdivision kernel in `f32` (Dammertz §2.3).
+    /// The float-precision subdivision kernel in `f32` (Dammertz §2.3) with this split
+    /// heuristic (§2.3.2, §2.5.2).
     Float(SplitHeuristic),
+    /// Adaptive screen-space termination at half a pixel of the scene camera (§2.5.3,
+    /// Tables 2.8–2.9); the rays are taken to start at the camera.
+    Adaptive,
+    /// A fixed depth: this many splits in total (Table 2.5's "fixed termination").
+    Depth(u8),
+    /// The mantissa distance `dist` on rational patches (§2.7.2, Table 2.12).
+    RationalDist(u32),
     /// The scene tessellated with this many triangles per patch (Dammertz Tables 2.1–2.4).
     Tessellated(u32),
 }
@@ -37,22 +47,58 @@ impl Method {
         match self {
             Method::Float(SplitHeuristic::Length) => "float, length heuristic".into(),
             Method::Float(SplitHeuristic::CrossProduct) => "float, cross-product heuristic".into(),
+            Method::Adaptive => "adaptive, half pixel".into(),
+            Method::Depth(d) => format!("depth {d}"),
+            Method::RationalDist(d) => format!("rational dist {d}"),
             Method::Tessellated(n) => format!("{n} triangles/patch"),
         }
     }
 
-    /// The methods of a default run: both heuristics, and the tessellations of Dammertz's
-    /// tables.
-    pub fn defaults() -> Vec<Method> {
-        vec![
+    /// Both heuristics and adaptive, then the given depths, distances and tessellations.
+    pub fn list(depths: &[u8], dists: &[u32], triangles: &[u32]) -> Vec<Method> {
+        let mut methods = vec![
             Method::Float(SplitHeuristic::Length),
             Method::Float(SplitHeuristic::CrossProduct),
-            Method::Tessellated(512),
-            Method::Tessellated(4608),
-            Method::Tessellated(131072),
-        ]
+            Method::Adaptive,
+        ];
+        methods.extend(depths.iter().map(|&d| Method::Depth(d)));
+        methods.extend(dists.iter().map(|&d| Method::RationalDist(d)));
+        methods.extend(triangles.iter().map(|&n| Method::Tessellated(n)));
+        methods
+    }
+
+    /// The kernel configuration of the method. `camera` sizes the pixels of adaptive
+    /// termination; a tessellation has no patches left, so the default is as good as any.
+    pub fn config(&self, camera: &Camera) -> SubdivisionConfig {
+        let base = SubdivisionConfig::default();
+        match *self {
+            Method::Float(heuristic) => SubdivisionConfig { heuristic, ..base },
+            Method::Adaptive => SubdivisionConfig {
+                termination: Termination::Adaptive(CameraRays::new(camera).footprint()),
+                ..base
+            },
+            Method::Depth(d) => SubdivisionConfig {
+                termination: Termination::Depth(d),
+                ..base
+            },
+            Method::RationalDist(rational_dist) => SubdivisionConfig {
+                rational_dist,
+                ..base
+            },
+            Method::Tessellated(_) => base,
+        }
     }
 }
+
+/// Depths of the fixed-depth rows: Dammertz gives no number for his Table 2.5; 8 to 20
+/// splits cover 16² to 1024² parameter cells per patch, from coarser than 512 triangles
+/// to finer than 131,072.
+pub const DEFAULT_DEPTHS: [u8; 4] = [8, 12, 16, 20];
+/// Mantissa distances of the rational rows, from Dammertz Table 2.12's range: 16 is our
+/// default, 64 and 2048 are his crack-free values with and without directed rounding.
+pub const DEFAULT_DISTS: [u32; 4] = [16, 64, 256, 2048];
+/// Triangles per patch of Dammertz Tables 2.1–2.4.
+pub const DEFAULT_TRIANGLES: [u32; 3] = [512, 4608, 131072];
 
 /// Minimum, maximum, mean and variance of an error over the rays where both hit.
 #[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
@@ -104,16 +150,32 @@ struct Reference {
     hit: Option<(DVec3, DVec3)>,
 }
 
-/// Hit point and normal of a hit, for a ray given in `f64`.
-fn point_and_normal(h: &SceneHit, origin: DVec3, dir: DVec3, use_shading: bool) -> (DVec3, DVec3) {
-    (
-        origin + dir * h.t,
-        if use_shading {
-            h.shading_normal
-        } else {
-            h.normal
-        },
-    )
+/// The point a method reports: the middle of the ray's chord through the hit box, in
+/// `f64`. Dammertz §2.3.4 takes "the middle of the returned interval"; the box centre
+/// itself can lie off the ray by half the box, and `origin + t dir` with the `f32` entry
+/// `t` is off by half an ulp of the hit distance, either of which would swamp the
+/// kernel's own error. For a triangle the box is the barycentric point widened by its
+/// rounding bound. If the box rounds off the ray, the entry point is used.
+fn hit_point(h: &SceneHit, r: &Ray) -> DVec3 {
+    let (origin, dir) = (r.origin.as_dvec3(), r.dir.as_dvec3());
+    let b = DAabb {
+        min: h.hit_box.min.as_dvec3(),
+        max: h.hit_box.max.as_dvec3(),
+    };
+    let t = b
+        .intersect(origin, dir.recip(), r.tmin as f64, f64::INFINITY)
+        .map_or(h.t, |(t0, t1)| 0.5 * (t0 + t1));
+    origin + dir * t
+}
+
+/// The normal a method is judged by: the shading normal of a tessellation (interpolated
+/// vertex normals, as Dammertz's triangles), the geometric one of a patch.
+fn normal(h: &SceneHit, use_shading: bool) -> DVec3 {
+    if use_shading {
+        h.shading_normal
+    } else {
+        h.normal
+    }
 }
 
 /// Runs every method over `rays` and compares with the `f64` reference.
@@ -124,18 +186,11 @@ pub fn run(
     mut progress: impl FnMut(&str),
 ) -> anyhow::Result<Vec<MethodResult>> {
     let exact = SceneGeometry::build(scene);
-    progress("f64 reference");
-    let reference_cfg = SubdivisionConfig::default();
-    let reference: Vec<Reference> = rays
-        .iter()
-        .map(|q| {
-            let mut stats = QueryStats::default();
-            let hit = exact
-                .intersect_f64(q.origin, q.dir, q.tmin, q.tmax, &reference_cfg, &mut stats)
-                .map(|h| point_and_normal(&h, q.origin, q.dir, false));
-            Reference { hit }
-        })
-        .collect();
+    // Every method traces the rays rounded once to f32, and so does the reference, in
+    // f64 (an f32 ray is exact in f64): the rounding of the ray itself moves the hit by
+    // about its distance times 2^-24 for every method alike and is the camera's error, not
+    // the intersector's, so it is kept out of the comparison (Dammertz §2.3.4 compares
+    // the kernels, not the ray generation).
     let f32_rays: Vec<Ray> = rays
         .iter()
         .map(|q| Ray {
@@ -145,27 +200,38 @@ pub fn run(
             tmax: q.tmax as f32,
         })
         .collect();
+    progress("f64 reference");
+    let reference_cfg = SubdivisionConfig::default();
+    let reference: Vec<Reference> = f32_rays
+        .iter()
+        .map(|r| {
+            let mut stats = QueryStats::default();
+            let (origin, dir) = (r.origin.as_dvec3(), r.dir.as_dvec3());
+            let hit = exact
+                .intersect_f64(
+                    origin,
+                    dir,
+                    r.tmin as f64,
+                    r.tmax as f64,
+                    &reference_cfg,
+                    &mut stats,
+                )
+                .map(|h| (origin + dir * h.t, h.normal));
+            Reference { hit }
+        })
+        .collect();
 
     let mut results = Vec::new();
     for method in methods {
         progress(&method.name());
-        let (geometry, memory, precision) = match *method {
-            Method::Float(heuristic) => {
-                let cfg = SubdivisionConfig {
-                    heuristic,
-                    ..SubdivisionConfig::default()
-                };
-                (None, patch_memory(scene), Precision::F32(cfg))
-            }
+        let precision = Precision::F32(method.config(&scene.camera));
+        let (geometry, memory) = match *method {
             Method::Tessellated(n) => {
                 let (meshes, report): (Scene, TessellationReport) =
                     tessellate_scene(scene, TessellationMode::TrianglesPerPatch(n))?;
-                (
-                    Some(SceneGeometry::build(&meshes)),
-                    report.bytes,
-                    Precision::F32(SubdivisionConfig::default()),
-                )
+                (Some(SceneGeometry::build(&meshes)), report.bytes)
             }
+            _ => (None, patch_memory(scene)),
         };
         let geometry = geometry.as_ref().unwrap_or(&exact);
         let shading = matches!(method, Method::Tessellated(_));
@@ -190,8 +256,7 @@ pub fn run(
         for ((answer, reference), r) in answers.iter().zip(&reference).zip(&f32_rays) {
             match (answer, &reference.hit) {
                 (Some(h), Some((p_ref, n_ref))) => {
-                    let (p, n) =
-                        point_and_normal(h, r.origin.as_dvec3(), r.dir.as_dvec3(), shading);
+                    let (p, n) = (hit_point(h, r), normal(h, shading));
                     let e = (p - p_ref).abs().element_sum();
                     hit_err.push(e);
                     rel_err.push(e / p_ref.abs().max_element().max(f64::MIN_POSITIVE));

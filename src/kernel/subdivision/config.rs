@@ -1,5 +1,7 @@
 //! Settings of the subdivision kernel: the split-direction heuristic (Dammertz §2.3.2 and
-//! §2.5.2) and the mantissa distance that ends the subdivision of rational patches (§2.7.2).
+//! §2.5.2), the termination criterion (float precision §2.3.3, a fixed depth as in his
+//! Table 2.5, adaptive screen-space §2.5.3) and the mantissa distance that ends the
+//! subdivision of rational patches (§2.7.2).
 
 /// How the next split direction is chosen from the corner control points.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -32,10 +34,49 @@ pub const DEFAULT_RATIONAL_DIST: u32 = 16;
 /// rounding bound the tests allow (tests/kernel_newton.rs).
 pub const DEFAULT_END_ULPS: u32 = 8;
 
+/// When a box is final, besides the guards every criterion keeps: the box stopped
+/// shrinking (§2.3.3), its L1 diameter fell below the end game ([`DEFAULT_END_ULPS`]), its
+/// parameter cell reached the per-direction limit ([`super::param`]), or, for rational
+/// patches, its corners are within the mantissa distance (§2.7.2). The guards keep every
+/// criterion terminating and crack free; with [`Termination::Float`] they are the whole test.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Termination {
+    /// Float precision (Dammertz §2.3.3): only the guards, i.e. subdivide until the box
+    /// stops shrinking in the kernel's float type.
+    #[default]
+    Float,
+    /// Fixed depth: a box is final once its parameter cell has been split this many times
+    /// in total (u and v splits together). This is the recursion depth of Dammertz's
+    /// algorithm 2.2.1, one split per step in the direction the heuristic picks, and the
+    /// "fixed termination criterion" of his Table 2.5.
+    Depth(u8),
+    /// Adaptive screen-space termination for primary rays (§2.5.3): a box is final when
+    /// its projection onto the image plane is at most half a pixel. Secondary rays must
+    /// not use it ([`SubdivisionConfig::for_secondary_rays`]).
+    Adaptive(ScreenFootprint),
+}
+
+/// What the adaptive criterion needs to know about the camera
+/// (`render::camera::CameraRays::footprint`). By the intercept theorem
+/// (§2.5.3, Fig. 2.22), a box of size `d` at distance `b` along a ray through a pixel at
+/// distance `a` from the eye projects to at most `a d / b`, which must not exceed `c`, half
+/// the pixel size. With the image plane at distance 1 along the view direction `f`, a ray
+/// `t ↦ eye + t dir` meets it at `a = |dir| / (dir · f)` and the box at `b = t |dir|`, so the
+/// test is `d ≤ c t (dir · f)`: no square root, one product per ray. `d` is the box's L1
+/// diameter, an upper bound on its Euclidean size, so the test stays conservative.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScreenFootprint {
+    /// Unit view direction `f` of the camera.
+    pub forward: [f32; 3],
+    /// Half a pixel's edge on the image plane at distance 1: `tan(fov_y / 2) / height`.
+    pub half_pixel: f32,
+}
+
 /// Configuration of [`super::intersect`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SubdivisionConfig {
     pub heuristic: SplitHeuristic,
+    pub termination: Termination,
     /// Mantissa distance of §2.7.2 for rational patches; 0 disables it (the L1 criterion
     /// alone then ends the subdivision).
     pub rational_dist: u32,
@@ -48,8 +89,49 @@ impl Default for SubdivisionConfig {
     fn default() -> Self {
         SubdivisionConfig {
             heuristic: SplitHeuristic::Length,
+            termination: Termination::Float,
             rational_dist: DEFAULT_RATIONAL_DIST,
             end_ulps: DEFAULT_END_ULPS,
         }
+    }
+}
+
+impl SubdivisionConfig {
+    /// The configuration for secondary rays: adaptive termination is defined by the
+    /// camera's pixels and so only for primary rays (§2.5.3, "this simple projection does
+    /// not work for secondary rays"); they fall back to float precision.
+    pub fn for_secondary_rays(self) -> SubdivisionConfig {
+        match self.termination {
+            Termination::Adaptive(_) => SubdivisionConfig {
+                termination: Termination::Float,
+                ..self
+            },
+            _ => self,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn secondary_rays_fall_back_to_float_precision_only_from_adaptive() {
+        let adaptive = SubdivisionConfig {
+            termination: Termination::Adaptive(ScreenFootprint {
+                forward: [0.0, 1.0, 0.0],
+                half_pixel: 1e-3,
+            }),
+            rational_dist: 64,
+            ..SubdivisionConfig::default()
+        };
+        let secondary = adaptive.for_secondary_rays();
+        assert_eq!(secondary.termination, Termination::Float);
+        assert_eq!(secondary.rational_dist, 64);
+        let depth = SubdivisionConfig {
+            termination: Termination::Depth(12),
+            ..SubdivisionConfig::default()
+        };
+        assert_eq!(depth.for_secondary_rays(), depth);
     }
 }

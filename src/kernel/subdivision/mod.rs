@@ -14,7 +14,8 @@
 //! No fixed epsilon appears anywhere: termination is the box's own precision (the L1
 //! diameter stops shrinking, or falls below `end_ulps` ulps of the patch's coordinates, or
 //! for rational patches the box corners come within `rational_dist` ulps), and depth is
-//! bounded by the parameter cell ([`param`]).
+//! bounded by the parameter cell ([`param`]). A coarser [`Termination`] (fixed depth,
+//! adaptive screen-space) can end it earlier, never later.
 
 pub mod bicubic;
 pub mod bilinear;
@@ -30,7 +31,10 @@ pub mod search;
 
 use std::cell::RefCell;
 
-pub use config::{DEFAULT_END_ULPS, DEFAULT_RATIONAL_DIST, SplitHeuristic, SubdivisionConfig};
+pub use config::{
+    DEFAULT_END_ULPS, DEFAULT_RATIONAL_DIST, ScreenFootprint, SplitHeuristic, SubdivisionConfig,
+    Termination,
+};
 pub use prepared::PreparedPatch;
 pub use reference::{PatchHit64, intersect_f64};
 

@@ -4,15 +4,11 @@
 //! The current sub-patch is split at 1/2 in place; both children's boxes are tested against
 //! the ray at once, the nearer hit child is continued with and the farther pushed (the
 //! "nearer side first" optimisation of §2.5, which needs no copy here because the net
-//! storage writes the children where they belong). A child whose box did not shrink in the
-//! L1 diameter (§2.3.3: a convex combination of neighbouring floats returns one of them, so
-//! the box stops changing at full precision) or, for a rational patch, whose box corners
-//! are within the mantissa distance (§2.7.2), or whose L1 diameter is below the end-game
-//! threshold ([`SubdivisionConfig::end_ulps`]), or whose parameter cell reached the depth
-//! limit ([`super::param`]), is a final box: a hit at its entry `t`, which shortens the ray
-//! so that farther stack entries are dropped.
+//! storage writes the children where they belong). Whether a child is a final box is
+//! [`Stop::is_final`]: a hit at its entry `t`, which shortens the ray so that farther stack
+//! entries are dropped.
 
-use super::config::SubdivisionConfig;
+use super::config::{SubdivisionConfig, Termination};
 use super::float::{GBox, GRay, KernelFloat};
 use super::heuristics::{Corners, choose};
 use super::param::{ParamCell, Split};
@@ -80,7 +76,7 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
     };
     let mut best: Option<SearchHit<T>> = None;
     let max = T::MAX_LEVEL;
-    let end_diameter = end_game_diameter(&root, cfg.end_ulps);
+    let stop = Stop::new(cfg, &root, ray, rational);
     loop {
         // A popped entry was tested against an older, longer ray; after a hit only strictly
         // nearer boxes matter.
@@ -112,17 +108,12 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
             let d = cur.bbox.l1_diameter();
             let child = |i: usize, t_enter: T| {
                 let cell = if i == 0 { cells.0 } else { cells.1 };
-                let (lu, lv) = cell.levels();
                 let b = boxes[i];
-                let bd = b.l1_diameter();
                 Node {
                     bbox: b,
                     t_enter,
                     cell,
-                    is_final: bd >= d
-                        || bd < end_diameter
-                        || (lu >= max && lv >= max)
-                        || (rational && b.mantissa_close(cfg.rational_dist)),
+                    is_final: stop.is_final(&b, d, cell, t_enter),
                 }
             };
             match (hit0, hit1) {
@@ -161,17 +152,72 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
     }
 }
 
-/// The L1 diameter below which a box is final: `end_ulps` ulps of the largest coordinate
-/// magnitude of the root box. The net's rounding error grows from that scale (every de
-/// Casteljau average rounds to it), so a box narrower than a few of its ulps is noise.
-fn end_game_diameter<T: KernelFloat>(root: &GBox<T>, end_ulps: u32) -> T {
-    let scale = (0..3)
-        .map(|i| {
-            root.min[i]
-                .max(-root.min[i])
-                .max(root.max[i])
-                .max(-root.max[i])
-        })
-        .fold(T::ZERO, |a, b| a.max(b));
-    (scale.next_up() - scale) * T::from_f64(end_ulps as f64)
+/// The termination test of one search, with what depends only on the root box and the
+/// ray computed once.
+struct Stop<T> {
+    /// The end-game L1 diameter: `end_ulps` ulps of the largest coordinate magnitude of
+    /// the root box. The net's rounding error grows from that scale (every de Casteljau
+    /// average rounds to it), so a box narrower than a few of its ulps is noise.
+    end_diameter: T,
+    /// The mantissa distance of §2.7.2 when the patch is rational.
+    rational_dist: Option<u32>,
+    criterion: Criterion<T>,
+}
+
+/// The part of [`Termination`] beyond the guards, in the search's float type.
+enum Criterion<T> {
+    Float,
+    /// Total splits (`level_u + level_v`) at which a cell is final.
+    Depth(u8),
+    /// `c (dir · f)` of [`super::config::ScreenFootprint`]: a box entered at `t` is final
+    /// when its L1 diameter is at most this times `t`.
+    Adaptive(T),
+}
+
+impl<T: KernelFloat> Stop<T> {
+    fn new(cfg: &SubdivisionConfig, root: &GBox<T>, ray: &GRay<T>, rational: bool) -> Self {
+        let scale = (0..3)
+            .map(|i| {
+                root.min[i]
+                    .max(-root.min[i])
+                    .max(root.max[i])
+                    .max(-root.max[i])
+            })
+            .fold(T::ZERO, |a, b| a.max(b));
+        let criterion = match cfg.termination {
+            Termination::Float => Criterion::Float,
+            Termination::Depth(d) => Criterion::Depth(d),
+            Termination::Adaptive(fp) => {
+                let along = (0..3)
+                    .map(|i| ray.dir[i] * T::from_f64(fp.forward[i] as f64))
+                    .fold(T::ZERO, |a, b| a + b);
+                Criterion::Adaptive(T::from_f64(fp.half_pixel as f64) * along)
+            }
+        };
+        Stop {
+            end_diameter: (scale.next_up() - scale) * T::from_f64(cfg.end_ulps as f64),
+            rational_dist: rational.then_some(cfg.rational_dist),
+            criterion,
+        }
+    }
+
+    /// Whether a child box `b` of a parent with L1 diameter `parent_diameter`, with
+    /// parameter cell `cell`, entered by the ray at `t_enter`, is final: the guards of
+    /// [`Termination`], then the selected criterion.
+    #[inline(always)]
+    fn is_final(&self, b: &GBox<T>, parent_diameter: T, cell: ParamCell, t_enter: T) -> bool {
+        let (lu, lv) = cell.levels();
+        let bd = b.l1_diameter();
+        bd >= parent_diameter
+            || bd < self.end_diameter
+            || (lu >= T::MAX_LEVEL && lv >= T::MAX_LEVEL)
+            || self
+                .rational_dist
+                .is_some_and(|dist| b.mantissa_close(dist))
+            || match self.criterion {
+                Criterion::Float => false,
+                Criterion::Depth(d) => lu as u32 + lv as u32 >= d as u32,
+                Criterion::Adaptive(k) => bd <= k * t_enter,
+            }
+    }
 }
