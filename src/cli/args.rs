@@ -218,6 +218,10 @@ pub struct RenderArgs {
     /// Worker threads (default: all cores). The image is identical for any count.
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Order in which pixels are traced (LG90 §5). The image is identical for any order;
+    /// the order matters for kernels that cache work between rays.
+    #[arg(long, value_enum, default_value_t = crate::render::order::SampleOrder::Tiles)]
+    pub order: crate::render::order::SampleOrder,
     /// Print statistics as JSON on stdout.
     #[arg(long)]
     pub stats: bool,
