@@ -52,6 +52,37 @@ pub enum BenchCommand {
     /// reference: holes, false hits, self-hits, hit distance, splits and NaN pixels per
     /// kernel path, as a Markdown table on stdout.
     Stability(StabilityArgs),
+    /// The timing tests of Lischinski & Gonczarowski 1990 (§7): the five teapot test cases
+    /// of Table 1 on the uniform grid, rendered with TOTH, ISRT, SCAN, ITBUF and PEANO;
+    /// each of Tables 2–6 printed beside the paper's numbers as Markdown, times normalized
+    /// to TOTH.
+    Lg90(Lg90Args),
+}
+
+#[derive(Debug, Args)]
+pub struct Lg90Args {
+    /// Image edge in pixels (the paper's is 512); smaller for quick runs.
+    #[arg(long, default_value_t = crate::bench::lg90::PAPER_SIZE)]
+    pub size: u32,
+    /// Test cases to run (1–5, as in Table 1).
+    #[arg(long, value_delimiter = ',', default_values_t = [1usize, 2, 3, 4, 5])]
+    pub cases: Vec<usize>,
+    /// Methods to run: TOTH, ISRT, SCAN, ITBUF, PEANO. Times are normalized to TOTH, so
+    /// keep it in the list to get them.
+    #[arg(long, value_delimiter = ',', default_values_t = ["TOTH", "ISRT", "SCAN", "ITBUF", "PEANO"].map(String::from))]
+    pub methods: Vec<String>,
+    /// Directory for the generated test scenes (default: a temporary one, removed after).
+    #[arg(long, value_name = "DIR")]
+    pub scene_dir: Option<PathBuf>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Also write the tables as CSV to this file.
+    #[arg(long, value_name = "FILE")]
+    pub csv: Option<PathBuf>,
+    /// Hide the progress bar.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 #[derive(Debug, Args)]
@@ -263,6 +294,10 @@ pub struct RenderArgs {
     /// Worker threads (default: all cores). The image is identical for any count.
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Order in which pixels are traced (LG90 §5). The image is identical for any order;
+    /// the order matters for kernels that cache work between rays.
+    #[arg(long, value_enum, default_value_t = crate::render::order::SampleOrder::Tiles)]
+    pub order: crate::render::order::SampleOrder,
     /// Print statistics as JSON on stdout.
     #[arg(long)]
     pub stats: bool,

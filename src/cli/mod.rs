@@ -6,6 +6,7 @@
 pub mod args;
 mod bench;
 mod bench_accuracy;
+mod bench_lg90;
 mod bvh;
 mod compare;
 mod convert;
@@ -69,6 +70,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Bench(args::BenchCommand::Accuracy(a)) => bench_accuracy::run(a),
         Command::Scene(args::SceneCommand::Teapots(a)) => scene_gen::teapots(a),
         Command::Bench(args::BenchCommand::Stability(a)) => bench::stability(a),
+        Command::Bench(args::BenchCommand::Lg90(a)) => bench_lg90::run(a),
     }
 }
 

@@ -11,7 +11,7 @@ use crate::cli::setup::{precision, prepare, thread_pool};
 use crate::render::film::{ImageFormat, write_effort};
 use crate::render::integrator::{Integrator, TraceSettings};
 use crate::render::plan::EffectPlan;
-use crate::render::renderer::{progress_bar, render_image};
+use crate::render::renderer::{progress_bar, render_image_in_order};
 use crate::render::stats::{PhaseTimes, RayReport};
 use crate::scene::LoadError;
 
@@ -61,7 +61,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     };
     let bar = progress_bar(args.quiet, "rendering");
     let start = Instant::now();
-    let rendered = pool.install(|| render_image(&integrator, &bar));
+    let rendered = pool.install(|| render_image_in_order(&integrator, args.order, &bar));
     let (film, tally) = (&rendered.film, &rendered.tally);
     let render_seconds = start.elapsed().as_secs_f64();
     let start = Instant::now();

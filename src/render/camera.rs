@@ -51,6 +51,22 @@ impl CameraRays {
         Ray::new(o.as_vec3(), d.as_vec3())
     }
 
+    /// The continuous pixel coordinates (x from the left, y from the top) and the depth
+    /// along the view direction of a point in front of the eye: the inverse of
+    /// [`CameraRays::ray_f64`]. `None` for a point on or behind the eye's plane.
+    pub fn project(&self, p: DVec3) -> Option<(f64, f64, f64)> {
+        let d = p - self.eye;
+        let depth = d.dot(self.forward);
+        if depth.is_nan() || depth <= 0.0 {
+            return None;
+        }
+        let a = d.dot(self.right) / depth;
+        let b = d.dot(self.up) / depth;
+        let x = (a * self.height / (self.scale * self.width) + 1.0) * self.width / 2.0;
+        let y = (1.0 - b / self.scale) * self.height / 2.0;
+        Some((x, y, depth))
+    }
+
     pub fn eye(&self) -> Vec3 {
         self.eye.as_vec3()
     }
@@ -94,6 +110,26 @@ mod tests {
             .map(|&(x, y)| cam.ray_f64(x, y, 0.5, 0.5).1)
             .sum();
         assert!((sum.normalize() - f).length() < 1e-12);
+    }
+
+    #[test]
+    fn projection_inverts_the_pixel_ray() {
+        let c = camera();
+        let cam = CameraRays::new(&c);
+        for &(x, y, sx, sy) in &[
+            (0, 0, 0.25, 0.75),
+            (639, 479, 0.5, 0.5),
+            (100, 300, 0.9, 0.1),
+        ] {
+            let (o, d) = cam.ray_f64(x, y, sx, sy);
+            let (px, py, depth) = cam.project(o + 7.0 * d).expect("in front");
+            assert!((px - (x as f64 + sx)).abs() < 1e-9, "{px} vs {x}+{sx}");
+            assert!((py - (y as f64 + sy)).abs() < 1e-9, "{py} vs {y}+{sy}");
+            // The depth along the view direction is the distance times the cosine.
+            let f = (c.look_at - c.eye).normalize();
+            assert!((depth - 7.0 * d.dot(f)).abs() < 1e-9);
+        }
+        assert!(cam.project(c.eye - (c.look_at - c.eye)).is_none());
     }
 
     #[test]

@@ -1,5 +1,6 @@
 //! Rendering an image: 16×16 tiles traced in parallel with rayon. Each pixel depends only
-//! on its own rays, so the image is the same, byte for byte, for any number of threads.
+//! on its own rays, so the image is the same, byte for byte, for any number of threads and
+//! any sampling order.
 
 use glam::Vec4;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -8,6 +9,7 @@ use rayon::prelude::*;
 use super::camera::CameraRays;
 use super::film::Film;
 use super::integrator::Integrator;
+use super::order::SampleOrder;
 use super::stats::RayTally;
 
 /// Edge of a square tile in pixels: small enough to balance two cores on a 512² image,
@@ -22,33 +24,43 @@ pub struct Rendered {
     pub effort: Vec<u32>,
 }
 
-/// A traced tile: its corner, (colour, splits) per pixel row-major, and its statistics.
-type TileResult = (u32, u32, Vec<(Vec4, u32)>, RayTally);
+/// A traced run of pixels: their indices, (colour, splits) per pixel in the same order,
+/// and their statistics.
+type ChunkResult = (Vec<u32>, Vec<(Vec4, u32)>, RayTally);
 
-/// Traces every pixel of the scene camera. `progress` is advanced per tile.
+/// Traces every pixel of the scene camera in the default order. `progress` is advanced
+/// per tile.
 pub fn render_image(integrator: &Integrator, progress: &ProgressBar) -> Rendered {
+    render_image_in_order(integrator, SampleOrder::default(), progress)
+}
+
+/// Traces every pixel of the scene camera in `order` (LG90 §5): the sequence is cut into
+/// runs of one tile's worth of pixels, which rayon hands out to the workers as contiguous
+/// shares, so each worker traces its pixels in the order's sequence. The image does not
+/// depend on the order.
+pub fn render_image_in_order(
+    integrator: &Integrator,
+    order: SampleOrder,
+    progress: &ProgressBar,
+) -> Rendered {
     let cam = &integrator.scene.camera;
     let (width, height) = (cam.width, cam.height);
     let rays = CameraRays::new(cam);
-    let tiles: Vec<(u32, u32)> = (0..height.div_ceil(TILE))
-        .flat_map(|ty| (0..width.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
-        .collect();
-    progress.set_length(tiles.len() as u64);
-    let results: Vec<TileResult> = tiles
-        .par_iter()
-        .map(|&(x0, y0)| {
+    let sequence = order.pixels(integrator.scene, &rays, width, height, TILE);
+    let run = (TILE * TILE) as usize;
+    progress.set_length(sequence.len().div_ceil(run) as u64);
+    let results: Vec<ChunkResult> = sequence
+        .par_chunks(run)
+        .map(|chunk| {
             let mut tally = RayTally::default();
-            let (x1, y1) = ((x0 + TILE).min(width), (y0 + TILE).min(height));
-            let mut px = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    let before = tally.splits();
-                    let color = integrator.primary(&rays.ray(x, y), &mut tally);
-                    px.push((color, (tally.splits() - before).min(u32::MAX as u64) as u32));
-                }
+            let mut px = Vec::with_capacity(chunk.len());
+            for &i in chunk {
+                let before = tally.splits();
+                let color = integrator.primary(&rays.ray(i % width, i / width), &mut tally);
+                px.push((color, (tally.splits() - before).min(u32::MAX as u64) as u32));
             }
             progress.inc(1);
-            (x0, y0, px, tally)
+            (chunk.to_vec(), px, tally)
         })
         .collect();
     let mut film = Film {
@@ -58,13 +70,10 @@ pub fn render_image(integrator: &Integrator, progress: &ProgressBar) -> Rendered
     };
     let mut effort = vec![0; (width * height) as usize];
     let mut total = RayTally::default();
-    for (x0, y0, px, tally) in results {
-        let w = (x0 + TILE).min(width) - x0;
-        for (k, (color, splits)) in px.into_iter().enumerate() {
-            let (x, y) = (x0 + k as u32 % w, y0 + k as u32 / w);
-            let i = (y * width + x) as usize;
-            film.pixels[i] = color;
-            effort[i] = splits;
+    for (indices, px, tally) in results {
+        for (i, (color, splits)) in indices.into_iter().zip(px) {
+            film.pixels[i as usize] = color;
+            effort[i as usize] = splits;
         }
         total = total.merge(tally);
     }
