@@ -65,7 +65,14 @@ pub struct Bvh {
 impl Bvh {
     /// Builds the tree over `boxes`; primitive `i` is the one with box `boxes[i]`.
     pub fn build(boxes: &[Aabb]) -> Bvh {
-        build::build(boxes)
+        build::build(boxes, boxes.len())
+    }
+
+    /// [`build`](Bvh::build) for a caller that tests primitives `first_packed..` in SIMD
+    /// packs of [`PACK_WIDTH`](crate::kernel::triangle::PACK_WIDTH) (triangles): their leaves are priced per started pack, so the
+    /// heuristic prefers full packs to more, emptier leaves.
+    pub fn build_packed(boxes: &[Aabb], first_packed: usize) -> Bvh {
+        build::build(boxes, first_packed)
     }
 
     /// Assembles a tree from its arrays (from another builder or a file), refusing any that
