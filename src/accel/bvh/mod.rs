@@ -5,6 +5,8 @@
 //!
 //! - [`build`](Bvh::build): top-down binned surface area heuristic (Wald, "On fast Construction
 //!   of SAH-based Bounding Volume Hierarchies", 2007) in place of Dammertz's median cut.
+//!   [`build_packed`](Bvh::build_packed) prices leaves of primitives tested in SIMD packs per
+//!   started pack, so the heuristic fills packs.
 //! - [`traverse`](Bvh::traverse) / [`traverse_any`](Bvh::traverse_any) /
 //!   [`traverse_leaves`](Bvh::traverse_leaves): stack-based, nearest-entry child first, no
 //!   allocation per ray, over a 4-wide form of the tree derived on construction (`wide`).
