@@ -197,7 +197,7 @@ impl SceneGeometry {
                     .map(|c| c.iter().copied().collect()),
             )
             .collect();
-        let bvh = Bvh::build(&boxes);
+        let bvh = Bvh::build_packed(&boxes, originals.len());
         {
             let accel = Accel::bvh(bvh, originals.len(), &triangles);
             Self::with_accel(originals, ids, triangles, accel)
@@ -288,14 +288,10 @@ impl SceneGeometry {
         precision: &Precision,
         stats: &mut QueryStats,
     ) -> Option<SceneHit> {
-        let mut kernel = KernelStats::default();
         let best = match &self.accel {
-            Accel::Bvh(bvh, packs) => {
-                self.nearest_in_bvh(bvh, packs, ray, precision, &mut kernel, stats)
-            }
-            Accel::Grid(grid) => self.nearest_in_grid(grid, ray, precision, &mut kernel, stats),
+            Accel::Bvh(bvh, packs) => self.nearest_in_bvh(bvh, packs, ray, precision, stats),
+            Accel::Grid(grid) => self.nearest_in_grid(grid, ray, precision, stats),
         };
-        stats.kernel.add(&kernel);
         Some(match best? {
             Candidate::Patch(prim, h) => {
                 self.finish_patch_hit(prim, h.t as f64, h.u as f64, h.v as f64, h.hit_box)
@@ -361,19 +357,10 @@ impl SceneGeometry {
     /// True when anything blocks `ray` in `[tmin, tmax]` (shadow rays).
     pub fn occluded(&self, ray: &Ray, precision: &Precision, stats: &mut QueryStats) -> bool {
         match precision {
-            Precision::F32(_) | Precision::Toth(_) => {
-                let mut kernel = KernelStats::default();
-                let hit = match &self.accel {
-                    Accel::Bvh(bvh, packs) => {
-                        self.blocked_in_bvh(bvh, packs, ray, precision, &mut kernel, stats)
-                    }
-                    Accel::Grid(grid) => {
-                        self.blocked_in_grid(grid, ray, precision, &mut kernel, stats)
-                    }
-                };
-                stats.kernel.add(&kernel);
-                hit
-            }
+            Precision::F32(_) | Precision::Toth(_) => match &self.accel {
+                Accel::Bvh(bvh, packs) => self.blocked_in_bvh(bvh, packs, ray, precision, stats),
+                Accel::Grid(grid) => self.blocked_in_grid(grid, ray, precision, stats),
+            },
             Precision::F64(_) => self.intersect(ray, precision, stats).is_some(),
         }
     }
@@ -386,11 +373,13 @@ impl SceneGeometry {
         packs: &LeafPacks,
         ray: &Ray,
         precision: &Precision,
-        kernel: &mut KernelStats,
         stats: &mut QueryStats,
     ) -> Option<Candidate> {
         let mut best = None;
-        let shear = PackShear::new(&RayShear::new(ray));
+        // The kernel counters borrowed apart from the traversal counters the closure leaves.
+        let kernel = &mut stats.kernel;
+        // Made at the first leaf: most rays that miss never reach one.
+        let mut shear = None;
         let patches = self.prepared.len() as u32;
         let t = bvh.traverse_leaves(ray, |range, tmax| {
             if patches > 0 {
@@ -409,9 +398,10 @@ impl SceneGeometry {
                 }
             }
             let (first, leaf_packs) = packs.of_leaf(&range);
+            let shear = shear.get_or_insert_with(|| PackShear::new(&RayShear::new(ray)));
             for (i, pack) in leaf_packs.iter().enumerate() {
                 kernel.patch_tests += 1;
-                let hits = intersect_pack(&shear, pack, ray.tmin, *tmax);
+                let hits = intersect_pack(shear, pack, ray.tmin, *tmax);
                 if hits.mask == 0 {
                     continue;
                 }
@@ -433,11 +423,11 @@ impl SceneGeometry {
         packs: &LeafPacks,
         ray: &Ray,
         precision: &Precision,
-        kernel: &mut KernelStats,
         stats: &mut QueryStats,
     ) -> bool {
         let shear = PackShear::new(&RayShear::new(ray));
         let patches = self.prepared.len() as u32;
+        let kernel = &mut stats.kernel;
         let mut hit = false;
         let t = bvh.traverse_leaves(ray, |range, _| {
             hit = bvh.prim_indices()[range.clone()]
@@ -464,10 +454,10 @@ impl SceneGeometry {
         grid: &Grid,
         ray: &Ray,
         precision: &Precision,
-        kernel: &mut KernelStats,
         stats: &mut QueryStats,
     ) -> Option<Candidate> {
         let mut best = None;
+        let kernel = &mut stats.kernel;
         let shear = RayShear::new(ray);
         let patches = self.prepared.len() as u32;
         let g = grid.traverse(ray, |prim, tmax| {
@@ -496,11 +486,11 @@ impl SceneGeometry {
         grid: &Grid,
         ray: &Ray,
         precision: &Precision,
-        kernel: &mut KernelStats,
         stats: &mut QueryStats,
     ) -> bool {
         let shear = RayShear::new(ray);
         let patches = self.prepared.len() as u32;
+        let kernel = &mut stats.kernel;
         let (hit, g) = grid.traverse_any(ray, |prim| {
             if prim < patches {
                 self.patch_occluded(prim, ray, precision, kernel)

@@ -245,7 +245,8 @@ impl PackHits {
 }
 
 /// [`intersect_triangle`] on the four lanes of `pack` at once, for `t` in `[tmin, tmax]`.
-#[inline]
+/// Always inlined: its result is a dozen registers that a call would pass through memory.
+#[inline(always)]
 pub fn intersect_pack(s: &PackShear, pack: &TrianglePack, tmin: f32, tmax: f32) -> PackHits {
     let [kx, ky, kz] = s.axes;
     // The sheared vertex, lane-wise exactly the scalar `shear(p - origin)` and `sz * (p - o).z`.

@@ -8,6 +8,7 @@ use glam::DVec3;
 
 use super::{Bvh, MAX_DEPTH, MAX_LEAF_PRIMS, Node};
 use crate::geom::Aabb;
+use crate::kernel::triangle::PACK_WIDTH;
 
 /// Centroid bins per axis. Wald 2007 §3.1 finds 16–32 bins within a few percent of the full
 /// sweep SAH; the upper end costs little for patch counts.
@@ -21,6 +22,18 @@ pub(super) const TRAVERSAL_COST: f64 = 1.0;
 /// patch work happens only for boxes the ray really hits, which no tree can avoid.
 pub(super) const PRIM_COST: f64 = 1.0;
 
+/// SAH cost per started pack of packed primitives: one pack test costs about one wide node
+/// test (callgrind, BENCHMARKS.md issue 4: ≈ 160 against ≈ 130 instructions), so a leaf of
+/// one to four packed primitives costs what a lone primitive does and the heuristic keeps
+/// packs full instead of splitting them into half-empty ones.
+pub(super) const PACK_COST: f64 = 1.0;
+
+/// Cost per unit area of a leaf with `count` primitives of which `packed` are tested in
+/// packs of [`PACK_WIDTH`].
+fn leaf_cost(count: usize, packed: usize) -> f64 {
+    PRIM_COST * (count - packed) as f64 + PACK_COST * packed.div_ceil(PACK_WIDTH) as f64
+}
+
 /// Surface area in `f64` (0 for an empty box).
 pub(super) fn area(b: &Aabb) -> f64 {
     if b.is_empty() {
@@ -30,7 +43,9 @@ pub(super) fn area(b: &Aabb) -> f64 {
     2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
 }
 
-pub(super) fn build(boxes: &[Aabb]) -> Bvh {
+/// The tree over `boxes`; primitives from `first_packed` on are priced in packs (see
+/// [`PACK_COST`]).
+pub(super) fn build(boxes: &[Aabb], first_packed: usize) -> Bvh {
     let n = boxes.len();
     // Indices are u32 in the file and the traversal callback.
     assert!(u32::try_from(n).is_ok(), "more than u32::MAX primitives");
@@ -41,6 +56,7 @@ pub(super) fn build(boxes: &[Aabb]) -> Bvh {
             .map(|b| (b.min.as_dvec3() + b.max.as_dvec3()) * 0.5)
             .collect(),
         prims: (0..n as u32).collect(),
+        first_packed: first_packed.min(n) as u32,
         nodes: Vec::with_capacity((2 * n).saturating_sub(1)),
     };
     if n > 0 {
@@ -58,6 +74,8 @@ struct Builder<'a> {
     boxes: &'a [Aabb],
     centroids: Vec<DVec3>,
     prims: Vec<u32>,
+    /// Primitives with this index or above are tested in packs.
+    first_packed: u32,
     nodes: Vec<Node>,
 }
 
@@ -65,11 +83,14 @@ struct Builder<'a> {
 struct Bin {
     bounds: Aabb,
     count: usize,
+    /// Of `count`, the primitives tested in packs.
+    packed: usize,
 }
 
 const EMPTY_BIN: Bin = Bin {
     bounds: Aabb::EMPTY,
     count: 0,
+    packed: 0,
 };
 
 /// Where to split `prims[start..end]`: by bin along an axis, or in the middle of the range when
@@ -135,8 +156,9 @@ impl Builder<'_> {
                 (lo.min(c), hi.max(c))
             },
         );
+        let packed = prims.iter().filter(|&&p| p >= self.first_packed).count();
         // Costs are compared without dividing by the parent's area, which may be 0.
-        let leaf_cost = PRIM_COST * count as f64 * area(bounds);
+        let as_leaf = leaf_cost(count, packed) * area(bounds);
         let mut best: Option<(f64, Split)> = None;
         for axis in 0..3 {
             let extent = cmax[axis] - cmin[axis];
@@ -150,6 +172,7 @@ impl Builder<'_> {
                 let b = &mut bins[bin_of(self.centroids[p as usize][axis], offset, scale)];
                 b.bounds = b.bounds.union(&self.boxes[p as usize]);
                 b.count += 1;
+                b.packed += usize::from(p >= self.first_packed);
             }
             // Sweep from the right to get each suffix, then from the left to price each split.
             let mut right_area = [0.0; BINS];
@@ -157,17 +180,20 @@ impl Builder<'_> {
             for i in (1..BINS).rev() {
                 acc.bounds = acc.bounds.union(&bins[i].bounds);
                 acc.count += bins[i].count;
-                right_area[i] = area(&acc.bounds) * acc.count as f64;
+                acc.packed += bins[i].packed;
+                right_area[i] = area(&acc.bounds) * leaf_cost(acc.count, acc.packed);
             }
             let mut left = EMPTY_BIN;
             for i in 0..BINS - 1 {
                 left.bounds = left.bounds.union(&bins[i].bounds);
                 left.count += bins[i].count;
+                left.packed += bins[i].packed;
                 if left.count == 0 || left.count == count {
                     continue;
                 }
                 let cost = TRAVERSAL_COST * area(bounds)
-                    + PRIM_COST * (area(&left.bounds) * left.count as f64 + right_area[i + 1]);
+                    + area(&left.bounds) * leaf_cost(left.count, left.packed)
+                    + right_area[i + 1];
                 if best.as_ref().is_none_or(|(c, _)| cost < *c) {
                     let split = Split::Bin {
                         axis,
@@ -180,7 +206,7 @@ impl Builder<'_> {
             }
         }
         match best {
-            Some((cost, _)) if cost >= leaf_cost && count <= MAX_LEAF_PRIMS => None,
+            Some((cost, _)) if cost >= as_leaf && count <= MAX_LEAF_PRIMS => None,
             Some((_, split)) => Some(split),
             None if count > MAX_LEAF_PRIMS => Some(Split::Middle),
             None => None,

@@ -5,6 +5,8 @@
 //!
 //! - [`build`](Bvh::build): top-down binned surface area heuristic (Wald, "On fast Construction
 //!   of SAH-based Bounding Volume Hierarchies", 2007) in place of Dammertz's median cut.
+//!   [`build_packed`](Bvh::build_packed) prices leaves of primitives tested in SIMD packs per
+//!   started pack, so the heuristic fills packs.
 //! - [`traverse`](Bvh::traverse) / [`traverse_any`](Bvh::traverse_any) /
 //!   [`traverse_leaves`](Bvh::traverse_leaves): stack-based, nearest-entry child first, no
 //!   allocation per ray, over a 4-wide form of the tree derived on construction (`wide`).
@@ -65,7 +67,14 @@ pub struct Bvh {
 impl Bvh {
     /// Builds the tree over `boxes`; primitive `i` is the one with box `boxes[i]`.
     pub fn build(boxes: &[Aabb]) -> Bvh {
-        build::build(boxes)
+        build::build(boxes, boxes.len())
+    }
+
+    /// [`build`](Bvh::build) for a caller that tests primitives `first_packed..` in SIMD
+    /// packs of [`PACK_WIDTH`](crate::kernel::triangle::PACK_WIDTH) (triangles): their leaves are priced per started pack, so the
+    /// heuristic prefers full packs to more, emptier leaves.
+    pub fn build_packed(boxes: &[Aabb], first_packed: usize) -> Bvh {
+        build::build(boxes, first_packed)
     }
 
     /// Assembles a tree from its arrays (from another builder or a file), refusing any that

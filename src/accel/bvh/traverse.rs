@@ -24,25 +24,29 @@ pub struct TraversalStats {
 }
 
 /// The ray in the form the 4-wide slab test wants: origin and reciprocal direction splat per
-/// axis, and per axis which box plane the ray meets first.
+/// axis, and per axis the index in [`WideNode::planes`](super::wide::WideNode) of the box
+/// plane the ray meets first (`near`) and last (`far`).
 struct WideRay {
     origin: [Vec4; 3],
     inv_dir: [Vec4; 3],
-    negative: [bool; 3],
+    near: [usize; 3],
+    far: [usize; 3],
 }
 
 impl WideRay {
     fn new(ray: &Ray) -> WideRay {
         let inv = ray.dir.recip();
+        // 1 / -0 is -inf: a ray with a -0 component counts as going down that axis.
+        let negative = [0, 1, 2].map(|k| usize::from(inv[k] < 0.0));
         WideRay {
             origin: [0, 1, 2].map(|k| Vec4::splat(ray.origin[k])),
             inv_dir: [0, 1, 2].map(|k| Vec4::splat(inv[k])),
-            // 1 / -0 is -inf: a ray with a -0 component counts as going down that axis.
-            negative: [0, 1, 2].map(|k| inv[k] < 0.0),
+            near: [0, 1, 2].map(|k| k + 3 * negative[k]),
+            far: [0, 1, 2].map(|k| k + 3 * (1 - negative[k])),
         }
     }
 
-    /// Entry and exit `t` of the four child boxes of `min`/`max`, clipped to `[tmin, tmax]`;
+    /// Entry and exit `t` of the four child boxes with `planes`, clipped to `[tmin, tmax]`;
     /// a lane is hit when entry <= exit. The robust slab test of [`crate::geom::bbox::slab`]
     /// on four boxes: the near plane of each axis is picked by the direction's sign, so an
     /// empty box (`min > max`) gives entry +inf and exit -inf. `0 * inf` (the origin on a
@@ -50,17 +54,12 @@ impl WideRay {
     /// `a.min(b)` return `b` when `a` is NaN (SSE `maxps`/`minps`; `f32::max` ignores NaN
     /// either way), so each chain starts from the slab values and ends in a number.
     #[inline(always)]
-    fn slab4(&self, min: &[Vec4; 3], max: &[Vec4; 3], tmin: f32, tmax: f32) -> (Vec4, Vec4) {
-        let t = |k: usize, near: bool| {
-            let plane = if self.negative[k] == near {
-                max[k]
-            } else {
-                min[k]
-            };
-            (plane - self.origin[k]) * self.inv_dir[k]
-        };
-        let enter = t(0, true).max(t(1, true).max(t(2, true).max(Vec4::splat(tmin))));
-        let exit = t(0, false).min(t(1, false).min(t(2, false).min(Vec4::splat(f32::INFINITY))));
+    fn slab4(&self, planes: &[Vec4; 6], tmin: f32, tmax: f32) -> (Vec4, Vec4) {
+        let t = |k: usize, plane: usize| (planes[plane] - self.origin[k]) * self.inv_dir[k];
+        let enter = t(0, self.near[0])
+            .max(t(1, self.near[1]).max(t(2, self.near[2]).max(Vec4::splat(tmin))));
+        let exit = t(0, self.far[0])
+            .min(t(1, self.far[1]).min(t(2, self.far[2]).min(Vec4::splat(f32::INFINITY))));
         (enter, (exit * SLAB_FAR_SCALE).min(Vec4::splat(tmax)))
     }
 }
@@ -139,31 +138,49 @@ impl Bvh {
             } else {
                 let node = &self.wide[current.index as usize];
                 stats.box_tests += WIDTH as u64;
-                let (enter, exit) = wray.slab4(&node.min, &node.max, tmin, tmax);
+                let (enter, exit) = wray.slab4(&node.planes, tmin, tmax);
                 let mut mask = enter.cmple(exit).bitmask();
-                // Push the hit children farthest first so the nearest is popped next; the
-                // nearest of all is visited straight away.
-                let mut hits = [(Child { index: 0, count: 0 }, 0.0f32); WIDTH];
-                let mut n = 0;
-                while mask != 0 {
-                    let lane = mask.trailing_zeros() as usize;
+                // Most nodes a primary ray enters have one or two children hit: those
+                // cases take no sort. The nearest child is visited straight away, the
+                // others are pushed farthest first so the nearest of them is popped next.
+                if mask != 0 {
+                    let a = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
-                    let entry = (node.children[lane], enter[lane]);
-                    // Insertion sort by decreasing entry t: at most four elements.
-                    let mut i = n;
-                    while i > 0 && hits[i - 1].1 < entry.1 {
-                        hits[i] = hits[i - 1];
-                        i -= 1;
+                    if mask == 0 {
+                        next = Some(node.children[a]);
+                    } else {
+                        let b = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        // Ties go to the later lane, as the insertion sort below orders them.
+                        let (near, far) = if enter[a] < enter[b] { (a, b) } else { (b, a) };
+                        if mask == 0 {
+                            stack[top].write((node.children[far], enter[far]));
+                            top += 1;
+                            next = Some(node.children[near]);
+                        } else {
+                            let mut hits = [(node.children[far], enter[far]); WIDTH];
+                            hits[1] = (node.children[near], enter[near]);
+                            let mut n = 2;
+                            while mask != 0 {
+                                let lane = mask.trailing_zeros() as usize;
+                                mask &= mask - 1;
+                                let entry = (node.children[lane], enter[lane]);
+                                // Insertion sort by decreasing entry t: at most four elements.
+                                let mut i = n;
+                                while i > 0 && hits[i - 1].1 < entry.1 {
+                                    hits[i] = hits[i - 1];
+                                    i -= 1;
+                                }
+                                hits[i] = entry;
+                                n += 1;
+                            }
+                            for &entry in &hits[..n - 1] {
+                                stack[top].write(entry);
+                                top += 1;
+                            }
+                            next = Some(hits[n - 1].0);
+                        }
                     }
-                    hits[i] = entry;
-                    n += 1;
-                }
-                if n > 0 {
-                    for &entry in &hits[..n - 1] {
-                        stack[top].write(entry);
-                        top += 1;
-                    }
-                    next = Some(hits[n - 1].0);
                 }
             }
             current = match next {

@@ -22,14 +22,15 @@ pub(super) struct Child {
     pub count: u32,
 }
 
-/// A wide node: child boxes per axis with one lane per child, then the children. Unused
-/// lanes have the empty box (`min = +inf`, `max = -inf`), which the slab test in
-/// `traverse` never enters, so they need no mask.
+/// A wide node: child box planes with one lane per child, `planes[axis]` the minima and
+/// `planes[3 + axis]` the maxima (one array, so that traversal picks a ray's near and far
+/// planes by an index computed once per ray), then the children. Unused lanes have the
+/// empty box (`min = +inf`, `max = -inf`), which the slab test in `traverse` never enters,
+/// so they need no mask.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub(super) struct WideNode {
-    pub min: [Vec4; 3],
-    pub max: [Vec4; 3],
+    pub planes: [Vec4; 6],
     pub children: [Child; WIDTH],
 }
 
@@ -60,8 +61,14 @@ fn push(nodes: &[Node], start: &[usize], wide: &mut Vec<WideNode>) -> u32 {
     }
     let at = wide.len();
     wide.push(WideNode {
-        min: [Vec4::splat(f32::INFINITY); 3],
-        max: [Vec4::splat(f32::NEG_INFINITY); 3],
+        planes: [
+            Vec4::INFINITY,
+            Vec4::INFINITY,
+            Vec4::INFINITY,
+            Vec4::NEG_INFINITY,
+            Vec4::NEG_INFINITY,
+            Vec4::NEG_INFINITY,
+        ],
         children: [Child { index: 0, count: 0 }; WIDTH],
     });
     for (lane, &k) in kids.iter().enumerate() {
@@ -87,7 +94,7 @@ fn push(nodes: &[Node], start: &[usize], wide: &mut Vec<WideNode>) -> u32 {
 
 fn set_lane(w: &mut WideNode, lane: usize, b: &Aabb) {
     for axis in 0..3 {
-        w.min[axis][lane] = b.min[axis];
-        w.max[axis][lane] = b.max[axis];
+        w.planes[axis][lane] = b.min[axis];
+        w.planes[3 + axis][lane] = b.max[axis];
     }
 }
