@@ -13,6 +13,7 @@ use glam::{DVec3, Vec3};
 use super::bvh::{Bvh, GeometryHasher};
 use super::grid::Grid;
 use crate::geom::{Aabb, BezierPatch, DAabb, Ray};
+use crate::kernel::cached::{self, CachedConfig};
 use crate::kernel::subdivision::{self, PreparedPatch, SubdivisionConfig};
 use crate::kernel::toth::{self, TothConfig};
 use crate::kernel::triangle::{
@@ -30,6 +31,8 @@ pub enum Precision {
     F64(SubdivisionConfig),
     /// Toth's interval Newton kernel (LG90 §4.1) on the `f64` patches, `f32` rays.
     Toth(TothConfig),
+    /// The cached surface-tree kernel (LG90 §4.2–4.3) on the `f64` patches, `f32` rays.
+    Cached(CachedConfig),
 }
 
 /// Work done by one query.
@@ -262,7 +265,9 @@ impl SceneGeometry {
         stats: &mut QueryStats,
     ) -> Option<SceneHit> {
         match precision {
-            Precision::F32(_) | Precision::Toth(_) => self.intersect_f32(ray, precision, stats),
+            Precision::F32(_) | Precision::Toth(_) | Precision::Cached(_) => {
+                self.intersect_f32(ray, precision, stats)
+            }
             Precision::F64(cfg) => {
                 let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
                 self.intersect_f64(o, d, ray.tmin as f64, ray.tmax as f64, cfg, stats)
@@ -349,7 +354,7 @@ impl SceneGeometry {
     /// True when anything blocks `ray` in `[tmin, tmax]` (shadow rays).
     pub fn occluded(&self, ray: &Ray, precision: &Precision, stats: &mut QueryStats) -> bool {
         match precision {
-            Precision::F32(_) | Precision::Toth(_) => {
+            Precision::F32(_) | Precision::Toth(_) | Precision::Cached(_) => {
                 let mut kernel = KernelStats::default();
                 let hit = match &self.accel {
                     Accel::Bvh(bvh, packs) => {
@@ -515,6 +520,9 @@ impl SceneGeometry {
             Precision::Toth(cfg) => {
                 toth::intersect(&self.originals[prim as usize], ray, cfg, kernel)
             }
+            Precision::Cached(cfg) => {
+                cached::intersect(&self.originals[prim as usize], ray, cfg, kernel)
+            }
             Precision::F32(cfg) | Precision::F64(cfg) => {
                 subdivision::intersect(&self.prepared[prim as usize], ray, cfg, kernel)
             }
@@ -532,6 +540,9 @@ impl SceneGeometry {
         match precision {
             Precision::Toth(cfg) => {
                 toth::occluded(&self.originals[prim as usize], ray, cfg, kernel)
+            }
+            Precision::Cached(cfg) => {
+                cached::occluded(&self.originals[prim as usize], ray, cfg, kernel)
             }
             Precision::F32(cfg) | Precision::F64(cfg) => {
                 subdivision::occluded(&self.prepared[prim as usize], ray, cfg, kernel)

@@ -8,25 +8,34 @@ use anyhow::Context;
 
 use crate::accel::scene::{Precision, SceneGeometry};
 use crate::cli::args::{AccelChoice, HeuristicChoice, KernelArgs, KernelChoice, PrecisionChoice};
+use crate::kernel::cached::CachedConfig;
 use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig};
 use crate::kernel::toth::TothConfig;
 use crate::scene::{Scene, load_scene};
 
 /// The kernel path selected by the flags, or why the flags do not go together.
 pub fn precision(args: &KernelArgs) -> anyhow::Result<Precision> {
-    if args.kernel == KernelChoice::Toth {
+    if matches!(args.kernel, KernelChoice::Toth | KernelChoice::Cached) {
         anyhow::ensure!(
             args.precision == PrecisionChoice::F32,
-            "--kernel toth works on f32 rays and has no --precision f64 variant; use --kernel subdivision --precision f64 for the reference"
+            "--kernel toth and --kernel cached work on f32 rays and have no --precision f64 variant; use --kernel subdivision --precision f64 for the reference"
         );
-        return Ok(Precision::Toth(TothConfig {
+        let toth = TothConfig {
             isrt: args.isrt,
             ..TothConfig::default()
-        }));
+        };
+        return Ok(match args.kernel {
+            KernelChoice::Cached => Precision::Cached(CachedConfig::new(
+                toth,
+                args.cache_size.saturating_mul(1 << 20),
+                args.cache_depth,
+            )),
+            _ => Precision::Toth(toth),
+        });
     }
     anyhow::ensure!(
         !args.isrt,
-        "--isrt applies to the Toth kernel only; add --kernel toth"
+        "--isrt applies to the Toth kernels only; add --kernel toth or --kernel cached"
     );
     let mut cfg = SubdivisionConfig {
         heuristic: match args.heuristic {
