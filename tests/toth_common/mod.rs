@@ -4,6 +4,8 @@
 //! precision).
 #![allow(dead_code)]
 
+pub mod render;
+
 use glam::DVec3;
 use patchtrace::geom::{BezierPatch, Ray};
 use patchtrace::kernel::PatchHit;
