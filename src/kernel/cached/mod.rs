@@ -29,10 +29,10 @@ use crate::kernel::{KernelStats, PatchHit};
 use lru::Lru;
 use tree::SurfaceTree;
 
-/// Cache budget per worker thread, in bytes. LG90 ran with 500K–1000K (Table 1) for up to
-/// 3200 patches; our nodes are 64 bytes (`f64` parameter boxes, an `f32` box, a child
-/// index), about three times theirs, and a modern core's share of cache memory is several
-/// MiB, so 8 MiB per worker keeps a few thousand patches' trees of a few dozen nodes.
+/// Cache budget per worker thread, in bytes. LG90 ran with 500K–1000K (Table 1). Our
+/// nodes are 64 bytes (`f64` parameter boxes, an `f32` box, a child index); the 512² teapot
+/// grows about 3 MiB of trees per worker at [`DEFAULT_MAX_DEPTH`] (BENCHMARKS.md, Issue 6),
+/// so 8 MiB holds it with room to spare while staying small next to a scene's own memory.
 pub const DEFAULT_CACHE_BYTES: usize = 8 << 20;
 
 /// Depth below which tree nodes are not cached (the paper's conclusion, §8). Depth 6
