@@ -31,7 +31,7 @@ fn csv_value(csv: &str, method: &str, stat: &str) -> f64 {
             f[2] == method && f[5] == stat
         })
         .unwrap_or_else(|| panic!("no {method} {stat} in\n{csv}"));
-    line.split(',').nth(6).unwrap().parse().unwrap()
+    line.split(',').nth(5).unwrap().parse().unwrap()
 }
 
 #[test]

@@ -3,26 +3,11 @@
 //! image, and the flag checks.
 
 mod common;
+mod kernel_common;
+mod toth_common;
 
 use common::{render, stderr, testdata};
-use patchtrace::diff::{DiffOptions, diff_images, read_image};
-
-/// Size of the test images: small enough for the dev profile, large enough that the
-/// teapot covers about a thousand pixels.
-const SIZE: (u32, u32) = (64, 64);
-
-/// Per-pixel difference (linear RGB, max over channels) above which a pixel counts as
-/// different: well above the shading noise of hit points that differ by f32 ulps, below
-/// any visible change of a surface's shade.
-const PIXEL_THRESHOLD: f64 = 0.05;
-
-/// Share of differing pixels allowed: a silhouette or shadow-boundary pixel may flip when
-/// the two kernels' hit points differ by their f32 precision; at 64² the teapot's outline
-/// and shadow edge are a few hundred pixels, of which at most a handful are that close.
-const MAX_DIFFERING_SHARE: f64 = 0.005;
-
-/// Root-mean-square difference allowed over the whole image.
-const MAX_RMSE: f64 = 0.01;
+use toth_common::render::{SIZE, assert_matches};
 
 #[test]
 fn teapot_with_toth_matches_the_subdivision_kernel() {
@@ -38,19 +23,8 @@ fn teapot_with_toth_matches_the_subdivision_kernel() {
         let out = render(&scene, &path(name), SIZE, extra);
         assert!(out.status.success(), "{name}: {}", stderr(&out));
     }
-    let reference = read_image(&path("subdivision.exr")).unwrap();
     for name in ["toth.exr", "isrt.exr"] {
-        let image = read_image(&path(name)).unwrap();
-        let opts = DiffOptions {
-            threshold: PIXEL_THRESHOLD,
-        };
-        let r = diff_images(&reference, &image, opts).unwrap();
-        assert!(
-            r.rmse <= MAX_RMSE && r.above_share <= MAX_DIFFERING_SHARE,
-            "{name}: rmse {} and {} pixels above {PIXEL_THRESHOLD}",
-            r.rmse,
-            r.above_count
-        );
+        assert_matches(&path("subdivision.exr"), &path(name));
     }
 }
 

@@ -13,6 +13,7 @@ use glam::{DVec3, Vec3};
 use super::bvh::{Bvh, GeometryHasher};
 use super::grid::Grid;
 use crate::geom::{Aabb, BezierPatch, DAabb, Ray};
+use crate::kernel::cached::{self, CachedConfig};
 use crate::kernel::subdivision::{self, PreparedPatch, SubdivisionConfig};
 use crate::kernel::toth::{self, TothConfig};
 use crate::kernel::triangle::{
@@ -30,6 +31,8 @@ pub enum Precision {
     F64(SubdivisionConfig),
     /// Toth's interval Newton kernel (LG90 §4.1) on the `f64` patches, `f32` rays.
     Toth(TothConfig),
+    /// The cached surface-tree kernel (LG90 §4.2–4.3) on the `f64` patches, `f32` rays.
+    Cached(CachedConfig),
 }
 
 impl Precision {
@@ -39,7 +42,7 @@ impl Precision {
         match self {
             Precision::F32(cfg) => Precision::F32(cfg.for_secondary_rays()),
             Precision::F64(cfg) => Precision::F64(cfg.for_secondary_rays()),
-            Precision::Toth(cfg) => Precision::Toth(cfg),
+            other @ (Precision::Toth(_) | Precision::Cached(_)) => other,
         }
     }
 }
@@ -274,7 +277,9 @@ impl SceneGeometry {
         stats: &mut QueryStats,
     ) -> Option<SceneHit> {
         match precision {
-            Precision::F32(_) | Precision::Toth(_) => self.intersect_f32(ray, precision, stats),
+            Precision::F32(_) | Precision::Toth(_) | Precision::Cached(_) => {
+                self.intersect_f32(ray, precision, stats)
+            }
             Precision::F64(cfg) => {
                 let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
                 self.intersect_f64(o, d, ray.tmin as f64, ray.tmax as f64, cfg, stats)
@@ -357,7 +362,7 @@ impl SceneGeometry {
     /// True when anything blocks `ray` in `[tmin, tmax]` (shadow rays).
     pub fn occluded(&self, ray: &Ray, precision: &Precision, stats: &mut QueryStats) -> bool {
         match precision {
-            Precision::F32(_) | Precision::Toth(_) => match &self.accel {
+            Precision::F32(_) | Precision::Toth(_) | Precision::Cached(_) => match &self.accel {
                 Accel::Bvh(bvh, packs) => self.blocked_in_bvh(bvh, packs, ray, precision, stats),
                 Accel::Grid(grid) => self.blocked_in_grid(grid, ray, precision, stats),
             },
@@ -517,6 +522,9 @@ impl SceneGeometry {
             Precision::Toth(cfg) => {
                 toth::intersect(&self.originals[prim as usize], ray, cfg, kernel)
             }
+            Precision::Cached(cfg) => {
+                cached::intersect(&self.originals[prim as usize], ray, cfg, kernel)
+            }
             Precision::F32(cfg) | Precision::F64(cfg) => {
                 subdivision::intersect(&self.prepared[prim as usize], ray, cfg, kernel)
             }
@@ -534,6 +542,9 @@ impl SceneGeometry {
         match precision {
             Precision::Toth(cfg) => {
                 toth::occluded(&self.originals[prim as usize], ray, cfg, kernel)
+            }
+            Precision::Cached(cfg) => {
+                cached::occluded(&self.originals[prim as usize], ray, cfg, kernel)
             }
             Precision::F32(cfg) | Precision::F64(cfg) => {
                 subdivision::occluded(&self.prepared[prim as usize], ray, cfg, kernel)

@@ -171,6 +171,9 @@ pub enum KernelChoice {
     Subdivision,
     /// Toth's interval Newton with Krawczyk's operator (Lischinski & Gonczarowski §4.1).
     Toth,
+    /// The same tests on regular quadtrees whose surface trees are cached per patch, LRU
+    /// (Lischinski & Gonczarowski §4.2–4.3).
+    Cached,
 }
 
 /// Arithmetic of the kernel.
@@ -253,9 +256,17 @@ pub struct KernelArgs {
     #[arg(long, value_name = "ULPS")]
     pub rational_dist: Option<u32>,
     /// Shadow rays stop at the first safe region, without Newton iteration (Lischinski &
-    /// Gonczarowski §6, the ISRT column). Only with `--kernel toth`.
+    /// Gonczarowski §6, the ISRT column). Only with `--kernel toth` or `--kernel cached`.
     #[arg(long)]
     pub isrt: bool,
+    /// Surface-tree cache of `--kernel cached` per worker thread, in MiB (Lischinski &
+    /// Gonczarowski §4.3).
+    #[arg(long, value_name = "MIB", default_value_t = crate::kernel::cached::DEFAULT_CACHE_BYTES >> 20)]
+    pub cache_size: usize,
+    /// Deepest cached level of the surface trees of `--kernel cached`; deeper boxes are
+    /// searched but not kept (Lischinski & Gonczarowski §8).
+    #[arg(long, value_name = "LEVELS", default_value_t = crate::kernel::cached::DEFAULT_MAX_DEPTH)]
+    pub cache_depth: u8,
     /// Load the BVH from this file (written by `patchtrace bvh`) instead of building it.
     #[arg(long, value_name = "FILE")]
     pub bvh: Option<PathBuf>,

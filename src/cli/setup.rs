@@ -10,6 +10,7 @@ use crate::accel::scene::{Precision, SceneGeometry};
 use crate::cli::args::{
     AccelChoice, HeuristicChoice, KernelArgs, KernelChoice, PrecisionChoice, TerminationChoice,
 };
+use crate::kernel::cached::CachedConfig;
 use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig, Termination};
 use crate::kernel::toth::TothConfig;
 use crate::render::camera::CameraRays;
@@ -18,19 +19,27 @@ use crate::scene::{Camera, Scene, load_scene};
 /// The kernel path selected by the flags, or why the flags do not go together; `camera`
 /// sizes the pixels of adaptive termination.
 pub fn precision(args: &KernelArgs, camera: &Camera) -> anyhow::Result<Precision> {
-    if args.kernel == KernelChoice::Toth {
+    if matches!(args.kernel, KernelChoice::Toth | KernelChoice::Cached) {
         anyhow::ensure!(
             args.precision == PrecisionChoice::F32,
-            "--kernel toth works on f32 rays and has no --precision f64 variant; use --kernel subdivision --precision f64 for the reference"
+            "--kernel toth and --kernel cached work on f32 rays and have no --precision f64 variant; use --kernel subdivision --precision f64 for the reference"
         );
-        return Ok(Precision::Toth(TothConfig {
+        let toth = TothConfig {
             isrt: args.isrt,
             ..TothConfig::default()
-        }));
+        };
+        return Ok(match args.kernel {
+            KernelChoice::Cached => Precision::Cached(CachedConfig::new(
+                toth,
+                args.cache_size.saturating_mul(1 << 20),
+                args.cache_depth,
+            )),
+            _ => Precision::Toth(toth),
+        });
     }
     anyhow::ensure!(
         !args.isrt,
-        "--isrt applies to the Toth kernel only; add --kernel toth"
+        "--isrt applies to the Toth kernels only; add --kernel toth or --kernel cached"
     );
     let mut cfg = SubdivisionConfig {
         heuristic: match args.heuristic {

@@ -53,7 +53,7 @@ fn trace_one(
 ) -> Option<(SceneHit, DVec3, DVec3)> {
     let mut stats = QueryStats::default();
     match precision {
-        Precision::F32(_) | Precision::Toth(_) => {
+        Precision::F32(_) | Precision::Toth(_) | Precision::Cached(_) => {
             let ray = Ray {
                 origin: q.origin.as_vec3(),
                 dir: q.dir.as_vec3(),

@@ -4,8 +4,11 @@
 //! - [`subdivision`]: Dammertz 2005 §2.2–2.3 and §2.7: subdivide until the bounding box
 //!   stops shrinking in `f32`, with an `f64` twin that is the accuracy reference.
 //! - [`toth`]: Toth's interval Newton with Krawczyk's operator (LG90 §4.1, §6).
+//! - [`cached`]: the same tests on regular quadtrees, with each patch's surface tree kept
+//!   in a per-thread LRU cache (LG90 §4.2–4.3).
 //! - [`secondary`]: origins of secondary rays at hit-box corners, §2.4.
 
+pub mod cached;
 pub mod secondary;
 pub mod subdivision;
 pub mod toth;
@@ -35,6 +38,8 @@ pub struct KernelStats {
     pub box_tests: u64,
     /// The Toth kernel's own counters (LG90 Tables 2–6 rows).
     pub toth: toth::TothStats,
+    /// The cached kernel's cache counters (LG90 Tables 2–6 rows).
+    pub cached: cached::CachedStats,
 }
 
 impl KernelStats {
@@ -43,5 +48,6 @@ impl KernelStats {
         self.splits += other.splits;
         self.box_tests += other.box_tests;
         self.toth.add(&other.toth);
+        self.cached.add(&other.cached);
     }
 }

@@ -3,6 +3,7 @@
 use serde::Serialize;
 
 use crate::accel::scene::QueryStats;
+use crate::kernel::cached::CachedStats;
 use crate::kernel::toth::TothStats;
 
 /// The kinds of ray the integrator traces.
@@ -74,6 +75,7 @@ pub struct RayTally {
     nodes: Tally,
     voxels: Tally,
     toth: TothStats,
+    cached: CachedStats,
 }
 
 impl RayTally {
@@ -85,6 +87,7 @@ impl RayTally {
         self.nodes.push(q.nodes_visited);
         self.voxels.push(q.voxels_visited);
         self.toth.add(&q.kernel.toth);
+        self.cached.add(&q.kernel.cached);
     }
 
     pub fn merge(mut self, o: RayTally) -> RayTally {
@@ -97,6 +100,7 @@ impl RayTally {
         self.nodes.merge(&o.nodes);
         self.voxels.merge(&o.voxels);
         self.toth.add(&o.toth);
+        self.cached.add(&o.cached);
         self
     }
 
@@ -127,6 +131,15 @@ impl RayTally {
             bvh_nodes_per_ray: self.nodes.spread(n),
             voxels_per_ray: self.voxels.spread(n),
             toth: (self.toth.searches > 0).then(|| TothReport::new(&self.toth, n)),
+            cache: (self.cached.hits + self.cached.misses > 0).then(|| CacheReport {
+                hits: self.cached.hits,
+                misses: self.cached.misses,
+                hit_ratio: self.cached.hit_ratio(),
+                evictions: self.cached.evictions,
+                nodes_created: self.cached.nodes_created,
+                subdivisions: self.cached.subdivisions,
+                uncached_subdivisions: self.cached.uncached_subdivisions,
+            }),
         }
     }
 }
@@ -147,6 +160,23 @@ pub struct RayReport {
     /// The Toth kernel's rows of LG90 Tables 2–6, when it ran.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub toth: Option<TothReport>,
+    /// The cached kernel's surface-tree cache (`--kernel cached`), when it ran.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cache: Option<CacheReport>,
+}
+
+/// LG90 Tables 2–6 cache rows of the cached kernel, over all ray–patch tests ("cache
+/// misses / surface" is `misses` over the scene's patch count).
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct CacheReport {
+    pub hits: u64,
+    pub misses: u64,
+    /// `hits / (hits + misses)`, a fraction (the paper prints percent).
+    pub hit_ratio: f64,
+    pub evictions: u64,
+    pub nodes_created: u64,
+    pub subdivisions: u64,
+    pub uncached_subdivisions: u64,
 }
 
 /// LG90 Tables 2–6 rows of the Toth kernel, per ray over all rays.

@@ -13,6 +13,7 @@ use indicatif::ProgressBar;
 
 use crate::accel::grid::DEFAULT_BUDGET_BYTES;
 use crate::accel::scene::{Precision, SceneGeometry};
+use crate::kernel::cached::{CachedConfig, DEFAULT_CACHE_BYTES, DEFAULT_MAX_DEPTH};
 use crate::kernel::secondary::DEFAULT_ULPS;
 use crate::kernel::toth::TothConfig;
 use crate::render::integrator::{Integrator, TraceSettings};
@@ -137,17 +138,10 @@ pub const METHODS: [Method; 5] = [
     },
 ];
 
-/// The cached kernel of §4.2–4.3 as a kernel path: the one place that names it. `None`
-/// while it is not merged; SCAN, ITBUF and PEANO then run the Toth kernel in their own
-/// sampling orders and are marked as stand-ins in the report.
-fn cached_precision() -> Option<Precision> {
-    None
-}
-
 impl Method {
-    /// The kernel path this method runs, and whether it is the Toth stand-in for a kernel
-    /// that is not available.
-    pub fn precision(&self) -> (Precision, bool) {
+    /// The kernel path this method runs; a cached method gets a fresh cache (a new
+    /// [`CachedConfig`] empties the workers' caches), so cases do not share trees.
+    pub fn precision(&self) -> Precision {
         let toth = |isrt| {
             Precision::Toth(TothConfig {
                 isrt,
@@ -155,12 +149,13 @@ impl Method {
             })
         };
         match self.kernel {
-            MethodKernel::Toth => (toth(false), false),
-            MethodKernel::Isrt => (toth(true), false),
-            MethodKernel::Cached => match cached_precision() {
-                Some(p) => (p, false),
-                None => (toth(false), true),
-            },
+            MethodKernel::Toth => toth(false),
+            MethodKernel::Isrt => toth(true),
+            MethodKernel::Cached => Precision::Cached(CachedConfig::new(
+                TothConfig::default(),
+                DEFAULT_CACHE_BYTES,
+                DEFAULT_MAX_DEPTH,
+            )),
         }
     }
 
@@ -187,8 +182,6 @@ pub struct Config {
 /// One method's run on one case.
 pub struct Run {
     pub method: Method,
-    /// Ran the Toth kernel in place of the cached one.
-    pub stand_in: bool,
     pub report: RayReport,
     /// Render seconds, excluding scene loading and grid building (as in §7.1).
     pub seconds: f64,
@@ -234,7 +227,7 @@ pub fn run(config: &Config, progress: &ProgressBar) -> Result<Vec<CaseResult>, L
         let mut runs = Vec::new();
         for method in &config.methods {
             progress.set_message(format!("case {} {}", case.number, method.name));
-            let (precision, stand_in) = method.precision();
+            let precision = method.precision();
             let integrator = Integrator {
                 scene: &scene,
                 geometry: &geometry,
@@ -249,7 +242,6 @@ pub fn run(config: &Config, progress: &ProgressBar) -> Result<Vec<CaseResult>, L
             let seconds = start.elapsed().as_secs_f64();
             runs.push(Run {
                 method: *method,
-                stand_in,
                 report: rendered.tally.report(),
                 seconds,
             });

@@ -75,10 +75,10 @@ impl Statistic {
     }
 }
 
-/// Our value of `stat` for `run`, `toth_seconds` being TOTH's time on the same case.
-/// `None` where we have no such number: the time without a TOTH run, and the cache rows
-/// until the cached kernel reports them.
-pub fn ours(stat: Statistic, run: &Run, toth_seconds: Option<f64>) -> Option<f64> {
+/// Our value of `stat` for `run` on a scene of `patches` patches, `toth_seconds` being
+/// TOTH's time on the same case. `None` where we have no such number: the time without a
+/// TOTH run, and the cache rows of kernels that cache nothing.
+pub fn ours(stat: Statistic, run: &Run, patches: usize, toth_seconds: Option<f64>) -> Option<f64> {
     let r = &run.report;
     let toth = r.toth.as_ref();
     let t = |f: fn(&crate::render::stats::TothReport) -> f64| Some(toth.map_or(0.0, f));
@@ -91,7 +91,12 @@ pub fn ours(stat: Statistic, run: &Run, toth_seconds: Option<f64>) -> Option<f64
         Statistic::NewtonStarts => t(|x| x.newton_starts_per_ray),
         Statistic::NewtonIterationsPerCall => t(|x| x.newton_iterations_per_call),
         Statistic::SafeRegionWidth => t(|x| x.mean_safe_region_width),
-        Statistic::CacheMissesPerSurface | Statistic::CacheHitRatio => None,
+        Statistic::CacheMissesPerSurface => r
+            .cache
+            .as_ref()
+            .map(|c| c.misses as f64 / patches.max(1) as f64),
+        // The paper prints percent.
+        Statistic::CacheHitRatio => r.cache.as_ref().map(|c| 100.0 * c.hit_ratio),
         Statistic::TotalRays => Some(r.total as f64),
     }
 }
@@ -153,8 +158,7 @@ pub fn markdown(results: &[CaseResult]) -> String {
         );
         s.push_str("| statistic |");
         for run in &result.runs {
-            let star = if run.stand_in { "*" } else { "" };
-            let _ = write!(s, " {}{star} | paper |", run.method.name);
+            let _ = write!(s, " {} | paper |", run.method.name);
         }
         s.push_str("\n|---|");
         s.push_str(&"---:|---:|".repeat(result.runs.len()));
@@ -167,16 +171,11 @@ pub fn markdown(results: &[CaseResult]) -> String {
                 let _ = write!(
                     s,
                     " {} | {} |",
-                    cell(ours(stat, run, toth), d),
+                    cell(ours(stat, run, result.patches, toth), d),
                     cell(papers(stat, run.method.name, result), d)
                 );
             }
             s.push('\n');
-        }
-        if result.runs.iter().any(|r| r.stand_in) {
-            s.push_str(
-                "\n\\* run with the Toth kernel in the method's sampling order: the cached kernel (§4.2–4.3) is not available in this build.\n",
-            );
         }
         s.push_str(
             "\nPer-ray rows are over all rays (the paper counts some only over rays that meet the scene's box or a surface); the paper's total rays are at 512².\n\n",
@@ -187,7 +186,7 @@ pub fn markdown(results: &[CaseResult]) -> String {
 
 /// The same numbers as CSV, one line per case, method and statistic.
 pub fn csv(results: &[CaseResult]) -> String {
-    let mut s = String::from("case,table,method,stand_in,order,statistic,ours,paper\n");
+    let mut s = String::from("case,table,method,order,statistic,ours,paper\n");
     for result in results {
         let toth = toth_seconds(result);
         for run in &result.runs {
@@ -195,14 +194,13 @@ pub fn csv(results: &[CaseResult]) -> String {
                 let v = |x: Option<f64>| x.map_or(String::new(), |x| x.to_string());
                 let _ = writeln!(
                     s,
-                    "{},{},{},{},{},{},{},{}",
+                    "{},{},{},{},{},{},{}",
                     result.case.number,
                     result.case.number + 1,
                     run.method.name,
-                    run.stand_in,
                     format!("{:?}", run.method.order).to_lowercase(),
                     stat.label(),
-                    v(ours(stat, run, toth)),
+                    v(ours(stat, run, result.patches, toth)),
                     v(papers(stat, run.method.name, result)),
                 );
             }

@@ -2,6 +2,11 @@
 //! Toth's bisection of `K ∩ X` instead of their regular subdivision): candidate boxes of
 //! parameter space are kept ordered by the lower bound of their ray parameter, so the
 //! first hit whose `t` is below every remaining bound is the nearest.
+//!
+//! Steps 3–7 of LG90's loop on one box (the ray–box test in ray coordinates, the box "too
+//! small for analysis", Krawczyk's test, simple Newton in a safe region, ISRT) are
+//! [`examine`]; only what happens to an undecided box differs between this kernel and the
+//! cached quadtree kernel ([`crate::kernel::cached`]), which calls [`examine`] too.
 
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -42,14 +47,20 @@ impl Ord for Candidate {
     }
 }
 
-/// Per-thread buffers: the projected net, a sub-net, a homogeneous net for hit boxes, and
-/// the candidate list.
+/// Per-thread buffers of one ray–patch search: the projected net, a sub-net, and a
+/// homogeneous net with its sub-net for hit boxes.
 #[derive(Default)]
-pub struct Scratch {
+pub struct Nets {
     projected: IntervalNet,
     sub: IntervalNet,
     homogeneous: IntervalNet,
     euclid_sub: IntervalNet,
+}
+
+/// Per-thread buffers of the Toth kernel: the nets and the candidate list.
+#[derive(Default)]
+pub struct Scratch {
+    nets: Nets,
     candidates: BinaryHeap<Candidate>,
 }
 
@@ -60,6 +71,126 @@ pub enum Goal {
     Nearest,
     /// Any hit (shadow rays).
     Any,
+}
+
+/// One ray against one patch: the ray's frame (the patch is projected into it, in
+/// [`Nets`]), the end-game size and the ray's start.
+pub struct PatchRay<'a> {
+    patch: &'a BezierPatch,
+    frame: RayFrame,
+    final_extent: f64,
+    tmin: f64,
+}
+
+impl<'a> PatchRay<'a> {
+    /// Projects `patch` into the frame of `ray` (into `nets`).
+    pub fn new(patch: &'a BezierPatch, ray: &Ray, cfg: &TothConfig, nets: &mut Nets) -> Self {
+        let frame = RayFrame::new(ray);
+        let (nu, nv) = (patch.degree_u() + 1, patch.degree_v() + 1);
+        frame.project(patch.homogeneous_points(), nu, nv, &mut nets.projected);
+        let b = patch.control_box();
+        let scale = b.max.abs().max(b.min.abs()).max_element();
+        PatchRay {
+            patch,
+            frame,
+            final_extent: cfg.final_ulps as f64 * ulp_of(scale as f32),
+            tmin: ray.tmin as f64,
+        }
+    }
+}
+
+/// What [`examine`] found in one box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Step {
+    /// The ray misses the box, the box is excluded, or its root lies outside `[tmin, tmax]`.
+    Miss,
+    /// A root (or, for ISRT, a proved one) with `t` in `[tmin, tmax]`.
+    Hit(PatchHit),
+    /// Undecided: every root of the box lies in `region`, and `ray_box` bounds the box in
+    /// ray coordinates. The caller subdivides, or answers it with [`final_box`] when it
+    /// cannot.
+    Undecided { region: ParamBox, ray_box: RayBox },
+}
+
+/// LG90 §4.2 steps 3–7 on the box `x`: the ray–box test in ray coordinates, the box too
+/// small for analysis (step 4), Krawczyk's test (5–6), and simple Newton in a safe region
+/// (7), or with `Goal::Any` and `cfg.isrt` the safe region alone (§6). Counts a search
+/// iteration when the ray meets the box.
+pub fn examine(
+    pr: &PatchRay,
+    nets: &mut Nets,
+    x: &ParamBox,
+    tmax: f64,
+    cfg: &TothConfig,
+    goal: Goal,
+    stats: &mut TothStats,
+) -> Step {
+    let Nets {
+        projected,
+        sub,
+        homogeneous,
+        euclid_sub,
+    } = nets;
+    projected.subnet_into(x, sub);
+    let rb = pr.frame.ray_box(sub);
+    stats.box_tests += 1;
+    if !rb.is_hit(pr.tmin, tmax) {
+        return Step::Miss;
+    }
+    stats.search_iterations += 1;
+    if pr.frame.extent(&rb) <= pr.final_extent {
+        return final_box(pr, nets, x, &rb, stats).map_or(Step::Miss, Step::Hit);
+    }
+    match classify(projected, sub, x) {
+        Classification::Excluded => {
+            stats.excluded += 1;
+            Step::Miss
+        }
+        Classification::Undecided { region } => Step::Undecided {
+            region,
+            ray_box: rb,
+        },
+        Classification::Safe {
+            region,
+            contraction,
+            inverse,
+        } => {
+            if goal == Goal::Any && cfg.isrt {
+                // ISRT: the safe region proves a root; its ray parameter lies in the
+                // sub-patch's t-range over K.
+                projected.subnet_into(&region, sub);
+                let kb = pr.frame.ray_box(sub);
+                stats.box_tests += 1;
+                if kb.t.lo() >= pr.tmin && kb.t.hi() <= tmax {
+                    stats.early_outs += 1;
+                    let (u, v) = region.mid();
+                    return Step::Hit(PatchHit {
+                        t: kb.t.mid() as f32,
+                        u: u as f32,
+                        v: v as f32,
+                        hit_box: enclosure_box(pr.patch, &region, homogeneous, euclid_sub),
+                    });
+                }
+                if kb.t.hi() < pr.tmin || kb.t.lo() > tmax {
+                    return Step::Miss;
+                }
+            }
+            stats.newton_starts += 1;
+            stats.safe_width_sum += x.width();
+            simple_newton(projected, x, &region, contraction, &inverse)
+                .and_then(|n| {
+                    stats.newton_iterations += n.iterations as u64;
+                    let t = ray_parameter(projected, n.u, n.v)?;
+                    (t >= pr.tmin && t <= tmax).then(|| PatchHit {
+                        t: t as f32,
+                        u: n.u as f32,
+                        v: n.v as f32,
+                        hit_box: enclosure_box(pr.patch, &n.enclosure, homogeneous, euclid_sub),
+                    })
+                })
+                .map_or(Step::Miss, Step::Hit)
+        }
+    }
 }
 
 /// Runs the search on one patch. With `Goal::Any` and `cfg.isrt`, a safe region whose ray
@@ -74,17 +205,7 @@ pub fn search(
     stats: &mut TothStats,
 ) -> Option<PatchHit> {
     stats.searches += 1;
-    let frame = RayFrame::new(ray);
-    let (nu, nv) = (patch.degree_u() + 1, patch.degree_v() + 1);
-    frame.project(patch.homogeneous_points(), nu, nv, &mut s.projected);
-    let scale = patch
-        .control_box()
-        .max
-        .abs()
-        .max(patch.control_box().min.abs())
-        .max_element();
-    let final_extent = cfg.final_ulps as f64 * ulp_of(scale as f32);
-    let tmin = ray.tmin as f64;
+    let pr = PatchRay::new(patch, ray, cfg, &mut s.nets);
     let mut tmax = ray.tmax as f64;
     let mut best: Option<PatchHit> = None;
     s.candidates.clear();
@@ -92,116 +213,32 @@ pub fn search(
         t_lo: f64::NEG_INFINITY,
         region: ParamBox::UNIT,
     });
-    let mut iterations = 0u32;
+    let start = stats.search_iterations;
     while let Some(c) = s.candidates.pop() {
         if c.t_lo > tmax {
             break;
         }
-        if iterations >= cfg.max_iterations {
+        if stats.search_iterations - start >= cfg.max_iterations as u64 {
             stats.cut_off += 1;
             break;
         }
-        s.projected.subnet_into(&c.region, &mut s.sub);
-        let rb = frame.ray_box(&s.sub);
-        stats.box_tests += 1;
-        if !rb.is_hit(tmin, tmax) {
-            continue;
-        }
-        iterations += 1;
-        stats.search_iterations += 1;
-        let hit = if frame.extent(&rb) <= final_extent {
-            stats.final_boxes += 1;
-            final_box_hit(
-                patch,
-                &s.projected,
-                &c.region,
-                &rb,
-                tmin,
-                (&mut s.homogeneous, &mut s.euclid_sub),
-            )
-        } else {
-            match classify(&s.projected, &s.sub, &c.region) {
-                Classification::Excluded => {
-                    stats.excluded += 1;
+        let hit = match examine(&pr, &mut s.nets, &c.region, tmax, cfg, goal, stats) {
+            Step::Miss => None,
+            Step::Hit(h) => Some(h),
+            Step::Undecided { region, ray_box } => match region.bisect() {
+                Some((a, b)) => {
+                    stats.bisections += 1;
+                    for region in [a, b] {
+                        s.candidates.push(Candidate {
+                            t_lo: ray_box.t.lo(),
+                            region,
+                        });
+                    }
                     None
                 }
-                Classification::Undecided { region } => {
-                    match region.bisect() {
-                        Some((a, b)) => {
-                            stats.bisections += 1;
-                            for region in [a, b] {
-                                s.candidates.push(Candidate {
-                                    t_lo: rb.t.lo(),
-                                    region,
-                                });
-                            }
-                            None
-                        }
-                        // Too narrow to split in f64: answer it like a final box.
-                        None => {
-                            stats.final_boxes += 1;
-                            final_box_hit(
-                                patch,
-                                &s.projected,
-                                &region,
-                                &rb,
-                                tmin,
-                                (&mut s.homogeneous, &mut s.euclid_sub),
-                            )
-                        }
-                    }
-                }
-                Classification::Safe {
-                    region,
-                    contraction,
-                    inverse,
-                } => {
-                    if goal == Goal::Any && cfg.isrt {
-                        // ISRT: the safe region proves a root; its ray parameter lies in
-                        // the sub-patch's t-range over K.
-                        s.projected.subnet_into(&region, &mut s.sub);
-                        let kb = frame.ray_box(&s.sub);
-                        stats.box_tests += 1;
-                        if kb.t.lo() >= tmin && kb.t.hi() <= tmax {
-                            stats.early_outs += 1;
-                            let (u, v) = region.mid();
-                            return Some(PatchHit {
-                                t: kb.t.mid() as f32,
-                                u: u as f32,
-                                v: v as f32,
-                                hit_box: enclosure_box(
-                                    patch,
-                                    &region,
-                                    &mut s.homogeneous,
-                                    &mut s.euclid_sub,
-                                ),
-                            });
-                        }
-                        if kb.t.hi() < tmin || kb.t.lo() > tmax {
-                            continue;
-                        }
-                    }
-                    stats.newton_starts += 1;
-                    stats.safe_width_sum += c.region.width();
-                    simple_newton(&s.projected, &c.region, &region, contraction, &inverse).and_then(
-                        |n| {
-                            stats.newton_iterations += n.iterations as u64;
-                            let t = ray_parameter(&s.projected, n.u, n.v)?;
-                            (t >= tmin && t <= tmax).then(|| PatchHit {
-                                t: t as f32,
-                                u: n.u as f32,
-                                v: n.v as f32,
-                                hit_box: enclosure_box(
-                                    patch,
-                                    &n.enclosure,
-                                    &mut s.homogeneous,
-                                    &mut s.euclid_sub,
-                                ),
-                            })
-                        },
-                    )
-                }
-            }
+                // Too narrow to split in f64: answer it like a final box.
+                None => final_box(&pr, &mut s.nets, &region, &ray_box, stats),
+            },
         };
         if let Some(h) = hit {
             if goal == Goal::Any {
@@ -222,17 +259,18 @@ fn ray_parameter(projected: &IntervalNet, u: f64, v: f64) -> Option<f64> {
 }
 
 /// A box too small for analysis that the ray passes through (LG90 §4.2 step 4): one Newton
-/// step from its centre refines (u, v) when it stays inside; the hit is at the box's entry.
-fn final_box_hit(
-    patch: &BezierPatch,
-    projected: &IntervalNet,
+/// step from its centre refines (u, v) when it stays inside; the hit is at the box's entry
+/// (`rb`, the box in ray coordinates).
+pub fn final_box(
+    pr: &PatchRay,
+    nets: &mut Nets,
     region: &ParamBox,
     rb: &RayBox,
-    tmin: f64,
-    (homogeneous, sub): (&mut IntervalNet, &mut IntervalNet),
+    stats: &mut TothStats,
 ) -> Option<PatchHit> {
+    stats.final_boxes += 1;
     let (mut u, mut v) = region.mid();
-    let (g, gu, gv) = projected.eval(u, v);
+    let (g, gu, gv) = nets.projected.eval(u, v);
     if let Some(inv) = invert([[gu[G1].mid(), gv[G1].mid()], [gu[G2].mid(), gv[G2].mid()]]) {
         let [du, dv] = newton_step(&inv, &g);
         if region.contains(u + du, v + dv) {
@@ -240,15 +278,20 @@ fn final_box_hit(
         }
     }
     Some(PatchHit {
-        t: rb.t.lo().max(tmin) as f32,
+        t: rb.t.lo().max(pr.tmin) as f32,
         u: u as f32,
         v: v as f32,
-        hit_box: enclosure_box(patch, region, homogeneous, sub),
+        hit_box: enclosure_box(
+            pr.patch,
+            region,
+            &mut nets.homogeneous,
+            &mut nets.euclid_sub,
+        ),
     })
 }
 
 /// The `f32` box, rounded outward, of the patch over `region`.
-fn enclosure_box(
+pub fn enclosure_box(
     patch: &BezierPatch,
     region: &ParamBox,
     homogeneous: &mut IntervalNet,

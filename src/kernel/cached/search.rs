@@ -1,0 +1,177 @@
+//! The search of Lischinski & Gonczarowski 1990, §4.2, on a surface tree: the ray first
+//! descends the cached tree to the leaves whose boxes it hits ("only the parametric
+//! subregions corresponding to those leaves ... need be searched"); each candidate then
+//! goes through the same steps as Toth's search ([`examine`]), and an undecided box is
+//! quartered (step 8), its quarters kept when they overlap `K` and the ray hits their
+//! boxes (step 9). Quarters are new tree nodes down to [`CachedConfig::max_depth`];
+//! below it they are searched but not cached (the paper's conclusion, §8).
+
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+use crate::geom::interval::{IntervalNet, ParamBox};
+use crate::geom::{BezierPatch, Ray};
+use crate::kernel::PatchHit;
+use crate::kernel::toth::TothStats;
+use crate::kernel::toth::search::{Goal, Nets, PatchRay, Step, examine, final_box};
+
+use super::CachedConfig;
+use super::stats::CachedStats;
+use super::tree::{SurfaceTree, quarters};
+
+/// A candidate box: a tree node, or a region below the depth limit.
+#[derive(Clone, Copy, Debug)]
+struct Candidate {
+    t_lo: f64,
+    region: ParamBox,
+    node: Option<u32>,
+}
+
+impl PartialEq for Candidate {
+    fn eq(&self, o: &Self) -> bool {
+        self.cmp(o) == Ordering::Equal
+    }
+}
+impl Eq for Candidate {}
+impl PartialOrd for Candidate {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Candidate {
+    /// Reversed, so that `BinaryHeap` pops the smallest `t_lo` first.
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.t_lo.total_cmp(&self.t_lo)
+    }
+}
+
+/// Per-thread buffers: the Toth nets, the nets for node boxes, the candidate list and the
+/// descent stack.
+#[derive(Default)]
+pub struct Scratch {
+    nets: Nets,
+    box_nets: [IntervalNet; 2],
+    candidates: BinaryHeap<Candidate>,
+    stack: Vec<u32>,
+}
+
+impl Scratch {
+    /// The nets [`SurfaceTree::new`] and [`SurfaceTree::split`] compute boxes in.
+    pub fn box_nets(&mut self) -> &mut [IntervalNet; 2] {
+        &mut self.box_nets
+    }
+}
+
+/// Searches `patch` for the nearest hit (or any, with `Goal::Any`) starting from the
+/// leaves of `tree` that the ray hits, growing the tree where boxes stay undecided.
+pub fn search(
+    patch: &BezierPatch,
+    ray: &Ray,
+    cfg: &CachedConfig,
+    goal: Goal,
+    tree: &mut SurfaceTree,
+    s: &mut Scratch,
+    (toth, cache): (&mut TothStats, &mut CachedStats),
+) -> Option<PatchHit> {
+    let inv = ray.dir.recip();
+    let hits_box = |t: &SurfaceTree, i: u32, tmax: f64, c: &mut CachedStats| {
+        c.tree_box_tests += 1;
+        let n = t.node(i);
+        n.bounds
+            .intersect(ray.origin, inv, ray.tmin, tmax as f32)
+            .map(|(t0, _)| t0 as f64)
+    };
+    s.candidates.clear();
+    s.stack.clear();
+    s.stack.push(0);
+    while let Some(i) = s.stack.pop() {
+        let Some(t_lo) = hits_box(tree, i, ray.tmax as f64, cache) else {
+            continue;
+        };
+        let n = tree.node(i);
+        match n.children {
+            Some(c) => s.stack.extend(c..c + 4),
+            None => s.candidates.push(Candidate {
+                t_lo,
+                region: n.region,
+                node: Some(i),
+            }),
+        }
+    }
+    if s.candidates.is_empty() {
+        // The ray misses every leaf: the surface is not searched (LG90 §7.1).
+        return None;
+    }
+    toth.searches += 1;
+    let pr = PatchRay::new(patch, ray, &cfg.toth, &mut s.nets);
+    let mut tmax = ray.tmax as f64;
+    let mut best: Option<PatchHit> = None;
+    let start = toth.search_iterations;
+    while let Some(c) = s.candidates.pop() {
+        if c.t_lo > tmax {
+            break;
+        }
+        if toth.search_iterations - start >= cfg.toth.max_iterations as u64 {
+            toth.cut_off += 1;
+            break;
+        }
+        let hit = match examine(&pr, &mut s.nets, &c.region, tmax, &cfg.toth, goal, toth) {
+            Step::Miss => None,
+            Step::Hit(h) => Some(h),
+            Step::Undecided { region, ray_box } => {
+                let cached = c
+                    .node
+                    .filter(|&i| tree.node(i).depth < cfg.max_depth)
+                    .and_then(|i| {
+                        let before = tree.len();
+                        let first = tree.split(i, patch, &mut s.box_nets)?;
+                        cache.nodes_created += (tree.len() - before) as u64;
+                        Some(first)
+                    });
+                match (cached, quarters(&c.region)) {
+                    (Some(first), _) => {
+                        cache.subdivisions += 1;
+                        for i in first..first + 4 {
+                            let q = tree.node(i).region;
+                            if q.intersect(&region).is_none() {
+                                continue;
+                            }
+                            if let Some(t_lo) = hits_box(tree, i, tmax, cache) {
+                                s.candidates.push(Candidate {
+                                    t_lo,
+                                    region: q,
+                                    node: Some(i),
+                                });
+                            }
+                        }
+                        None
+                    }
+                    (None, Some(qs)) => {
+                        cache.subdivisions += 1;
+                        cache.uncached_subdivisions += 1;
+                        for q in qs {
+                            if q.intersect(&region).is_some() {
+                                s.candidates.push(Candidate {
+                                    t_lo: ray_box.t.lo(),
+                                    region: q,
+                                    node: None,
+                                });
+                            }
+                        }
+                        None
+                    }
+                    // Too narrow to quarter in f64: answer it like a final box.
+                    (None, None) => final_box(&pr, &mut s.nets, &region, &ray_box, toth),
+                }
+            }
+        };
+        if let Some(h) = hit {
+            if goal == Goal::Any {
+                return Some(h);
+            }
+            tmax = h.t as f64;
+            best = Some(h);
+        }
+    }
+    best
+}
