@@ -71,9 +71,9 @@ fn bench_accuracy_writes_table_csv_and_plot() {
     assert!(o.status.success(), "{}", stderr(&o));
     let results: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     let rows = results.as_array().unwrap();
-    // Both heuristics, adaptive, the four default depths and the two tessellations (the
-    // teapot has no rational patches, so no dist rows).
-    assert_eq!(rows.len(), 9, "{results}");
+    // Both heuristics, adaptive, the four default depths, the two tessellations and the
+    // two LG90 kernels (the teapot has no rational patches, so no dist rows).
+    assert_eq!(rows.len(), 11, "{results}");
     let row = |name: &str| {
         rows.iter()
             .find(|r| r["method"] == name)
@@ -88,6 +88,10 @@ fn bench_accuracy_writes_table_csv_and_plot() {
             && mean("4608 triangles/patch") < mean("8 triangles/patch"),
         "{results}"
     );
+    // The LG90 kernels converge to the surface as well: below the coarse tessellation.
+    for lg90 in ["LG90 Toth", "LG90 cached"] {
+        assert!(mean(lg90) < mean("8 triangles/patch"), "{results}");
+    }
     assert_eq!(row(float)["holes"], 0);
     assert_eq!(row(float)["rays"], 24 * 24);
     for f in [

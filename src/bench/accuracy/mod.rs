@@ -16,7 +16,9 @@ use serde::Serialize;
 
 use crate::accel::scene::{Precision, QueryStats, SceneGeometry, SceneHit};
 use crate::geom::{DAabb, Ray};
+use crate::kernel::cached::CachedConfig;
 use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig, Termination};
+use crate::kernel::toth::TothConfig;
 use crate::render::camera::CameraRays;
 use crate::scene::rays::RayQuery;
 use crate::scene::{Camera, Scene};
@@ -40,6 +42,10 @@ pub enum Method {
     RationalDist(u32),
     /// The scene tessellated with this many triangles per patch (Dammertz Tables 2.1–2.4).
     Tessellated(u32),
+    /// Toth's interval Newton kernel (LG90 §4.1).
+    Toth,
+    /// The cached surface-tree kernel (LG90 §4.2–4.3), with a fresh cache.
+    Cached,
 }
 
 impl Method {
@@ -51,10 +57,13 @@ impl Method {
             Method::Depth(d) => format!("depth {d}"),
             Method::RationalDist(d) => format!("rational dist {d}"),
             Method::Tessellated(n) => format!("{n} triangles/patch"),
+            Method::Toth => "LG90 Toth".into(),
+            Method::Cached => "LG90 cached".into(),
         }
     }
 
-    /// Both heuristics and adaptive, then the given depths, distances and tessellations.
+    /// Both heuristics and adaptive, then the given depths, distances and tessellations,
+    /// then the LG90 kernels.
     pub fn list(depths: &[u8], dists: &[u32], triangles: &[u32]) -> Vec<Method> {
         let mut methods = vec![
             Method::Float(SplitHeuristic::Length),
@@ -64,14 +73,17 @@ impl Method {
         methods.extend(depths.iter().map(|&d| Method::Depth(d)));
         methods.extend(dists.iter().map(|&d| Method::RationalDist(d)));
         methods.extend(triangles.iter().map(|&n| Method::Tessellated(n)));
+        methods.extend([Method::Toth, Method::Cached]);
         methods
     }
 
-    /// The kernel configuration of the method. `camera` sizes the pixels of adaptive
-    /// termination; a tessellation has no patches left, so the default is as good as any.
-    pub fn config(&self, camera: &Camera) -> SubdivisionConfig {
+    /// The kernel path of the method. `camera` sizes the pixels of adaptive termination;
+    /// a tessellation has no patches left, so the default is as good as any.
+    pub fn precision(&self, camera: &Camera) -> Precision {
         let base = SubdivisionConfig::default();
-        match *self {
+        Precision::F32(match *self {
+            Method::Toth => return Precision::Toth(TothConfig::default()),
+            Method::Cached => return Precision::Cached(CachedConfig::default()),
             Method::Float(heuristic) => SubdivisionConfig { heuristic, ..base },
             Method::Adaptive => SubdivisionConfig {
                 termination: Termination::Adaptive(CameraRays::new(camera).footprint()),
@@ -86,7 +98,7 @@ impl Method {
                 ..base
             },
             Method::Tessellated(_) => base,
-        }
+        })
     }
 }
 
@@ -224,7 +236,6 @@ pub fn run(
     let mut results = Vec::new();
     for method in methods {
         progress(&method.name());
-        let precision = Precision::F32(method.config(&scene.camera));
         let (geometry, memory) = match *method {
             Method::Tessellated(n) => {
                 let (meshes, report): (Scene, TessellationReport) =
@@ -238,6 +249,9 @@ pub fn run(
         let mut answers = Vec::new();
         let mut times = Vec::new();
         for run in 0..=TIMED_RUNS {
+            // A fresh configuration per run: the cached kernel then starts every run with
+            // an empty cache instead of the trees of the previous pass over the same rays.
+            let precision = method.precision(&scene.camera);
             let start = Instant::now();
             let mut stats = QueryStats::default();
             answers = f32_rays
