@@ -11,7 +11,9 @@ use glam::{DAffine3, DVec3};
 use kernel_common::Rng;
 use patchtrace::geom::{Aabb, BezierPatch, Ray};
 use patchtrace::kernel::secondary::{DEFAULT_ULPS, secondary_origin};
-use patchtrace::kernel::subdivision::{PreparedPatch, SubdivisionConfig, intersect, occluded};
+use patchtrace::kernel::subdivision::{
+    PreparedPatch, SubdivisionConfig, intersect, occluded, widen_by_net_rounding,
+};
 use patchtrace::kernel::{KernelStats, PatchHit};
 use patchtrace::scene::bpt::read_bpt;
 
@@ -184,7 +186,9 @@ fn secondary_rays_do_not_hit_their_own_patch_at_their_origin() {
                     if d.dot(side) <= 0.0 {
                         continue;
                     }
-                    let o = secondary_origin(&h.hit_box, n, outside, DEFAULT_ULPS);
+                    // The renderer's origin box: the hit box widened by the net's rounding.
+                    let leave = widen_by_net_rounding(h.hit_box, &prepared[k].bounds());
+                    let o = secondary_origin(&leave, n, outside, DEFAULT_ULPS);
                     let sec = Ray::new(o, d);
                     checked += 1;
                     if let Some(s) = intersect(&prepared[k], &sec, &cfg, &mut stats)

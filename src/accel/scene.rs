@@ -80,6 +80,10 @@ pub struct SceneHit {
     /// The final box of the subdivision (the hit interval), secondary rays start at its
     /// corners (Dammertz §2.4).
     pub hit_box: Aabb,
+    /// The box secondary rays leave from (Dammertz §2.4): for a patch the hit box widened
+    /// by the rounding of the kernel's sub-patch nets
+    /// ([`subdivision::widen_by_net_rounding`]), for a triangle the hit box.
+    pub leave_box: Aabb,
     /// Unit geometric normal: `∂S/∂u × ∂S/∂v` at (u, v) from the exact `f64` derivatives
     /// for a patch, the face normal for a triangle.
     pub normal: DVec3,
@@ -562,6 +566,10 @@ impl SceneGeometry {
             u,
             v,
             hit_box,
+            leave_box: subdivision::widen_by_net_rounding(
+                hit_box,
+                &self.prepared[prim as usize].bounds(),
+            ),
             normal,
             shading_normal: normal,
         }
@@ -590,6 +598,7 @@ impl SceneGeometry {
             u: h.b1 as f64,
             v: h.b2 as f64,
             hit_box: triangle::hit_box(h, a, b, c),
+            leave_box: triangle::hit_box(h, a, b, c),
             normal,
             shading_normal,
         }

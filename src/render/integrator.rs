@@ -71,7 +71,7 @@ impl Integrator<'_> {
         let opaque = 1.0 - m.transmit.min(1.0);
 
         let mut color = self.scene.ambient * m.diffuse * opaque;
-        let above = secondary_origin(&hit.hit_box, n_out, true, ulps);
+        let above = secondary_origin(&hit.leave_box, n_out, true, ulps);
         for light in &self.scene.lights {
             let (to_light, tmax, intensity) = match *light {
                 Light::Point {
@@ -124,7 +124,7 @@ impl Integrator<'_> {
             }
             if m.transmit > 0.0 && plan.refraction {
                 let through =
-                    self.transmitted(d, n, n_out, outside, m.ior, &hit.hit_box, depth, tally);
+                    self.transmitted(d, n, n_out, outside, m.ior, &hit.leave_box, depth, tally);
                 color += m.transmit * through;
             }
         }
@@ -142,7 +142,7 @@ impl Integrator<'_> {
         n_out: Vec3,
         entering: bool,
         ior: f32,
-        hit_box: &crate::geom::Aabb,
+        leave_box: &crate::geom::Aabb,
         depth: u32,
         tally: &mut RayTally,
     ) -> Vec3 {
@@ -150,7 +150,10 @@ impl Integrator<'_> {
         let eta = if entering { 1.0 / ior } else { ior };
         let cos_i = -d.dot(n);
         let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
-        let reflected = Ray::new(secondary_origin(hit_box, n_out, true, ulps), reflect(d, n));
+        let reflected = Ray::new(
+            secondary_origin(leave_box, n_out, true, ulps),
+            reflect(d, n),
+        );
         if k < 0.0 {
             return self
                 .radiance(&reflected, RayKind::Reflection, depth + 1, tally)
@@ -160,7 +163,7 @@ impl Integrator<'_> {
         // Schlick uses the cosine on the optically thinner side.
         let cos = if entering { cos_i } else { k.sqrt() };
         let f = schlick(cos, ior);
-        let refracted = Ray::new(secondary_origin(hit_box, n_out, false, ulps), t_dir);
+        let refracted = Ray::new(secondary_origin(leave_box, n_out, false, ulps), t_dir);
         let through = self
             .radiance(&refracted, RayKind::Refraction, depth + 1, tally)
             .0;

@@ -386,8 +386,8 @@ fn secondaries(
     let light = (n + 0.99 * rng.direction()).normalize_or(n);
     let refract = refraction(d, n);
     let n32 = n.as_vec3();
-    let above = secondary_origin(&h.hit_box, n32, true, DEFAULT_ULPS);
-    let below = secondary_origin(&h.hit_box, n32, false, DEFAULT_ULPS);
+    let above = secondary_origin(&h.leave_box, n32, true, DEFAULT_ULPS);
+    let below = secondary_origin(&h.leave_box, n32, false, DEFAULT_ULPS);
     for (origin, dir) in [(above, reflect), (above, light), (below, refract)] {
         let dir = dir.as_vec3();
         if dir == Vec3::ZERO || !dir.is_finite() {

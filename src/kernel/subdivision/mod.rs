@@ -67,7 +67,8 @@ thread_local! {
 }
 
 /// Per-axis margin, in ulps of the patch's largest coordinate magnitude, by which a hit box
-/// is widened to cover the rounding of the sub-patch net. Every de Casteljau average rounds
+/// is widened before secondary rays leave from its corner, to cover the rounding of the
+/// sub-patch net. Every de Casteljau average rounds
 /// to the scale of the values it averages, which early in the search is the whole patch's
 /// (Dammertz §2.3.3), so a final box that is thin where the coordinates are small (near a
 /// coordinate plane) can miss the exact surface by a fraction of that ulp, and a secondary
@@ -78,7 +79,6 @@ thread_local! {
 pub const NET_ROUNDING_ULPS: f64 = 2.0;
 
 /// Nearest hit with `t` in `[ray.tmin, ray.tmax]`; `ray.tmax` is the current closest hit.
-/// The hit box is the final box widened by [`NET_ROUNDING_ULPS`].
 pub fn intersect(
     patch: &PreparedPatch,
     ray: &Ray,
@@ -91,14 +91,15 @@ pub fn intersect(
             t: h.t,
             u: u as f32,
             v: v as f32,
-            hit_box: widen_by_net_rounding(h.bbox.to_aabb(), &patch.bounds),
+            hit_box: h.bbox.to_aabb(),
         }
     })
 }
 
 /// `hit_box` grown on every side by [`NET_ROUNDING_ULPS`] ulps of the largest coordinate
-/// magnitude of `root`, the patch's box.
-fn widen_by_net_rounding(hit_box: Aabb, root: &Aabb) -> Aabb {
+/// magnitude of `root`, the patch's box: the box secondary rays leave from. The hit box
+/// itself (and `t` at its entry) stays the final box, so the margin costs no accuracy.
+pub fn widen_by_net_rounding(hit_box: Aabb, root: &Aabb) -> Aabb {
     let scale = root.min.abs().max(root.max.abs()).max_element();
     let margin = Vec3::splat((ulp_of(scale) * NET_ROUNDING_ULPS) as f32);
     Aabb::new(hit_box.min - margin, hit_box.max + margin)
