@@ -115,12 +115,15 @@ impl SubdivisionConfig {
 mod tests {
     use super::*;
 
+    /// Any camera's half-pixel angle will do here: the test is about which rays keep it.
+    const SOME_HALF_PIXEL: f32 = 1e-3;
+
     #[test]
     fn secondary_rays_fall_back_to_float_precision_only_from_adaptive() {
         let adaptive = SubdivisionConfig {
             termination: Termination::Adaptive(ScreenFootprint {
                 forward: [0.0, 1.0, 0.0],
-                half_pixel: 1e-3,
+                half_pixel: SOME_HALF_PIXEL,
             }),
             rational_dist: 64,
             ..SubdivisionConfig::default()

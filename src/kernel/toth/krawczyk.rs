@@ -137,6 +137,14 @@ mod tests {
         s
     }
 
+    /// How far the root may move in (u, v): the ray is rounded to f32, which moves the root
+    /// of this unit-sized plane by a few f32 ulps of 1 (2^-23 ≈ 1.2e-7 each).
+    const F32_RAY_ROOT_SHIFT: f64 = 1e-6;
+    /// What rounding alone leaves of a quantity that is exactly 0 for a linear system (the
+    /// width of K, the contraction ‖I − Y G'(X)‖): a handful of outward-rounded operations
+    /// on numbers of size 1 give a few f64 ulps (2.2e-16 each), far below this.
+    const ROUNDING_ONLY: f64 = 1e-9;
+
     #[test]
     fn the_whole_domain_of_a_plane_is_a_safe_region_around_the_root() {
         let (net, _) = setup();
@@ -148,12 +156,15 @@ mod tests {
                 ..
             } => {
                 // The ray is rounded to f32, so the root moves by f32 ulps of (0.3, 0.6).
-                assert!((region.u.mid() - 0.3).abs() < 1e-6 && (region.v.mid() - 0.6).abs() < 1e-6);
                 assert!(
-                    region.width() < 1e-9,
+                    (region.u.mid() - 0.3).abs() < F32_RAY_ROOT_SHIFT
+                        && (region.v.mid() - 0.6).abs() < F32_RAY_ROOT_SHIFT
+                );
+                assert!(
+                    region.width() < ROUNDING_ONLY,
                     "K of a linear system is a point: {region:?}"
                 );
-                assert!(contraction < 1e-9);
+                assert!(contraction < ROUNDING_ONLY);
             }
             other => panic!("expected a safe region, got {other:?}"),
         }
