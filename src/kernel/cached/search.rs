@@ -6,44 +6,20 @@
 //! boxes (step 9). Quarters are new tree nodes down to [`CachedConfig::max_depth`];
 //! below it they are searched but not cached (the paper's conclusion, §8).
 
-use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
-use crate::geom::interval::{IntervalNet, ParamBox};
+use crate::geom::interval::IntervalNet;
 use crate::geom::{BezierPatch, Ray};
 use crate::kernel::PatchHit;
 use crate::kernel::toth::TothStats;
-use crate::kernel::toth::search::{Goal, Nets, PatchRay, Step, examine, final_box};
+use crate::kernel::toth::search::{self, Goal, Nets, PatchRay, Step, examine, final_box};
 
 use super::CachedConfig;
 use super::stats::CachedStats;
 use super::tree::{SurfaceTree, quarters};
 
-/// A candidate box: a tree node, or a region below the depth limit.
-#[derive(Clone, Copy, Debug)]
-struct Candidate {
-    t_lo: f64,
-    region: ParamBox,
-    node: Option<u32>,
-}
-
-impl PartialEq for Candidate {
-    fn eq(&self, o: &Self) -> bool {
-        self.cmp(o) == Ordering::Equal
-    }
-}
-impl Eq for Candidate {}
-impl PartialOrd for Candidate {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Candidate {
-    /// Reversed, so that `BinaryHeap` pops the smallest `t_lo` first.
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.t_lo.total_cmp(&self.t_lo)
-    }
-}
+/// A candidate box: a tree node, or a region below the depth limit (`node` is `None`).
+type Candidate = search::Candidate<Option<u32>>;
 
 /// Per-thread buffers: the Toth nets, the nets for node boxes, the candidate list and the
 /// descent stack.

@@ -22,25 +22,27 @@ use super::newton::simple_newton;
 use super::raynet::{G1, G2, RayBox, RayFrame};
 use super::stats::TothStats;
 
-/// A box waiting in the candidate list, keyed by a lower bound of its ray parameter.
+/// A box waiting in the candidate list, keyed by a lower bound of its ray parameter; `node`
+/// is what else a kernel keeps with it (the cached kernel's tree node).
 #[derive(Clone, Copy, Debug)]
-struct Candidate {
-    t_lo: f64,
-    region: ParamBox,
+pub struct Candidate<N = ()> {
+    pub t_lo: f64,
+    pub region: ParamBox,
+    pub node: N,
 }
 
-impl PartialEq for Candidate {
+impl<N> PartialEq for Candidate<N> {
     fn eq(&self, o: &Self) -> bool {
         self.cmp(o) == Ordering::Equal
     }
 }
-impl Eq for Candidate {}
-impl PartialOrd for Candidate {
+impl<N> Eq for Candidate<N> {}
+impl<N> PartialOrd for Candidate<N> {
     fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
         Some(self.cmp(o))
     }
 }
-impl Ord for Candidate {
+impl<N> Ord for Candidate<N> {
     /// Reversed, so that `BinaryHeap` pops the smallest `t_lo` first.
     fn cmp(&self, o: &Self) -> Ordering {
         o.t_lo.total_cmp(&self.t_lo)
@@ -212,6 +214,7 @@ pub fn search(
     s.candidates.push(Candidate {
         t_lo: f64::NEG_INFINITY,
         region: ParamBox::UNIT,
+        node: (),
     });
     let start = stats.search_iterations;
     while let Some(c) = s.candidates.pop() {
@@ -232,6 +235,7 @@ pub fn search(
                         s.candidates.push(Candidate {
                             t_lo: ray_box.t.lo(),
                             region,
+                            node: (),
                         });
                     }
                     None
