@@ -66,9 +66,27 @@ impl Dyadic {
         }
     }
 
+    /// Position of the leading bit of `|m| · 2^e` (`None` for zero).
+    fn top_bit(self) -> Option<i32> {
+        (self.m != 0).then(|| 128 - self.m.unsigned_abs().leading_zeros() as i32 + self.e)
+    }
+
+    /// Exact order. Numbers of one sign whose leading bits differ are ordered by those
+    /// bits alone, so only numbers of similar magnitude are aligned (a product's 106-bit
+    /// mantissa beside a far smaller bound would overflow `i128` when shifted).
     fn cmp(a: Dyadic, b: Dyadic) -> Ordering {
-        let (x, y, _) = Dyadic::aligned(a, b);
-        x.cmp(&y)
+        let sign = a.m.signum().cmp(&b.m.signum());
+        if sign != Ordering::Equal || a.m == 0 {
+            return sign;
+        }
+        match a.top_bit().cmp(&b.top_bit()) {
+            Ordering::Equal => {
+                let (x, y, _) = Dyadic::aligned(a, b);
+                x.cmp(&y)
+            }
+            by_magnitude if a.m > 0 => by_magnitude,
+            by_magnitude => by_magnitude.reverse(),
+        }
     }
 }
 
