@@ -34,14 +34,14 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         )
         .into());
     }
-    if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty()) {
-        if !dir.is_dir() {
-            return Err(LoadError::invalid(
-                &args.output,
-                format!("the directory {} does not exist", dir.display()),
-            )
-            .into());
-        }
+    if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty())
+        && !dir.is_dir()
+    {
+        return Err(LoadError::invalid(
+            &args.output,
+            format!("the directory {} does not exist", dir.display()),
+        )
+        .into());
     }
     let pool = thread_pool(args.threads)?;
     let mut prepared = prepare(&args.scene, &args.kernel)?;

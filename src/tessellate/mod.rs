@@ -205,13 +205,13 @@ impl Plan {
 /// The grid `(g_u, g_v)` for `n` triangles per patch; see
 /// [`TessellationMode::TrianglesPerPatch`].
 pub fn grid_for_triangles(n: u32) -> Result<(u32, u32), TessellateError> {
-    if n == 0 || n % 2 != 0 {
+    if n == 0 || !n.is_multiple_of(2) {
         return Err(TessellateError::TriangleCount(n));
     }
     let cells = n / 2;
     let grid_v = (1..=cells)
         .take_while(|g| g * g <= cells)
-        .filter(|g| cells % g == 0)
+        .filter(|g| cells.is_multiple_of(*g))
         .last()
         .unwrap_or(1);
     Ok((cells / grid_v, grid_v))

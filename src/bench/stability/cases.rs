@@ -439,7 +439,13 @@ fn seam_rays(patches: &[BezierPatch], n: usize, rng: &mut SplitMix64) -> Vec<Ray
     (0..n)
         .map(|k| {
             let p = &patches[rng.next_u64() as usize % patches.len()];
-            let corner = |r: &mut SplitMix64| if r.next_u64() % 2 == 0 { 0.0 } else { 1.0 };
+            let corner = |r: &mut SplitMix64| {
+                if r.next_u64().is_multiple_of(2) {
+                    0.0
+                } else {
+                    1.0
+                }
+            };
             let (u, v) = match k % 3 {
                 0 => (corner(rng), corner(rng)),
                 1 => (corner(rng), rng.uniform()),

@@ -352,7 +352,7 @@ fn surface_meets_box(patch: &BezierPatch, target: &DAabb, depth: u32) -> bool {
     if inside || depth >= MEET_MAX_DEPTH {
         return true;
     }
-    let halves = if depth % 2 == 0 {
+    let halves = if depth.is_multiple_of(2) {
         patch.split_u()
     } else {
         patch.split_v()

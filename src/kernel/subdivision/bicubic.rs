@@ -13,7 +13,7 @@ use glam::{Mat4, Vec3A, Vec4};
 
 use super::heuristics::Corners;
 use super::param::Split;
-use super::register::{RegisterNet, reduce3};
+use super::register::{LaneNet, reduce3};
 use crate::geom::BezierPatch;
 
 /// One coordinate of the net: `rows[j]` holds the points (0..4, j), or when the net is
@@ -80,7 +80,7 @@ impl Net {
     }
 }
 
-impl RegisterNet for Net {
+impl LaneNet for Net {
     #[inline(always)]
     fn bounds_pair(a: &Net, b: &Net) -> [(Vec3A, Vec3A); 2] {
         [a, b].map(|n| {

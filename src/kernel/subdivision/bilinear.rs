@@ -12,7 +12,7 @@ use glam::{BVec4A, Vec3A, Vec4, Vec4Swizzles};
 
 use super::heuristics::Corners;
 use super::param::Split;
-use super::register::{RegisterNet, reduce3};
+use super::register::{LaneNet, reduce3};
 use crate::geom::BezierPatch;
 
 /// Lanes of the corners a split in u replaces in the lower child: `b(1,0)` and `b(1,1)`.
@@ -43,7 +43,7 @@ impl BilinearNet {
     }
 }
 
-impl RegisterNet for BilinearNet {
+impl LaneNet for BilinearNet {
     #[inline(always)]
     fn split_in_place(&mut self, dir: Split) -> BilinearNet {
         let half = Vec4::splat(0.5);

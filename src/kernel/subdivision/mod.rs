@@ -17,6 +17,8 @@
 //! bounded by the parameter cell ([`param`]). A coarser [`Termination`] (fixed depth,
 //! adaptive screen-space) can end it earlier, never later.
 
+#[cfg(target_arch = "x86_64")]
+pub mod avx512;
 pub mod bicubic;
 pub mod bilinear;
 pub mod config;
@@ -58,6 +60,10 @@ type RegisterScratch<N> = (Vec<N>, Vec<search::Node<f32>>);
 thread_local! {
     /// Per-thread buffers of the bicubic path: the pushed nets and the search nodes.
     static BICUBIC_SCRATCH: RefCell<RegisterScratch<Net>> =
+        const { RefCell::new((Vec::new(), Vec::new())) };
+    /// Per-thread buffers of the bicubic path on AVX-512.
+    #[cfg(target_arch = "x86_64")]
+    static BICUBIC16_SCRATCH: RefCell<RegisterScratch<avx512::Net16>> =
         const { RefCell::new((Vec::new(), Vec::new())) };
     /// Per-thread buffers of the bilinear path.
     static BILINEAR_SCRATCH: RefCell<RegisterScratch<BilinearNet>> =
@@ -130,6 +136,12 @@ fn run(
     );
     let root = GBox::from_aabb(patch.bounds);
     match &patch.data {
+        #[cfg(target_arch = "x86_64")]
+        Prepared::Bicubic(net) if avx512::available() => {
+            BICUBIC16_SCRATCH.with_borrow_mut(|(slots, nodes)| {
+                avx512::search_net16(net, slots, nodes, root, &gray, cfg, any_hit, stats)
+            })
+        }
         Prepared::Bicubic(net) => BICUBIC_SCRATCH.with_borrow_mut(|(slots, nodes)| {
             search_register(*net, slots, nodes, root, &gray, cfg, any_hit, stats)
         }),

@@ -4,7 +4,7 @@
 use super::bicubic::Net;
 use super::bilinear::BilinearNet;
 use super::general::{NetShape, net_box};
-use super::register::RegisterNet;
+use super::register::LaneNet;
 use crate::geom::{Aabb, BezierPatch};
 
 /// Which path a patch takes (Dammertz §2.7.1: the choice is made once, before any ray).

@@ -22,8 +22,29 @@ use super::search::{NetStack, Node, SearchHit, search};
 use crate::geom::bbox::slab;
 use crate::kernel::KernelStats;
 
-/// A control net of fixed size held in SIMD registers.
+/// The boxes of a split's two children (lower first), each with the entry `t` of its slab
+/// test if the ray hits it.
+pub type ChildTests = [(GBox<f32>, Option<f32>); 2];
+
+/// A control net of fixed size held in SIMD registers, as the search sees it: one step
+/// splits it and tests both children against the ray.
 pub trait RegisterNet: Copy {
+    /// What the split tests need of the ray, in the net's register form, computed once
+    /// per search.
+    type RayRegisters: Copy;
+    fn ray_registers(ray: &GRay<f32>) -> Self::RayRegisters;
+    /// Splits at 1/2 in `dir`: `self` becomes the lower half, the upper half is returned
+    /// with both halves' boxes (lower first), each with the entry `t` of the slab test
+    /// ([`slab`]) clipped to `[ray.tmin, tmax]` if the ray hits it.
+    fn split_test(&mut self, dir: Split, ray: &Self::RayRegisters, tmax: f32)
+    -> (Self, ChildTests);
+    /// Corner points `b(0,0)`, `b(n,0)`, `b(0,m)` for the split heuristics.
+    fn corners(&self) -> Corners<f32>;
+}
+
+/// A net of one SSE register per coordinate row ([`super::bicubic`], [`super::bilinear`]),
+/// whose boxes come out as `(min, max)` vectors for the SSE slab test.
+pub trait LaneNet: Copy {
     /// Splits at 1/2 in `dir`: `self` becomes the lower half, the upper half is returned.
     fn split_in_place(&mut self, dir: Split) -> Self;
     /// The control boxes of two nets as `(min, max)` vectors, computed together so that
@@ -42,6 +63,46 @@ pub trait RegisterNet: Copy {
     }
 }
 
+impl<N: LaneNet> RegisterNet for N {
+    /// Origin, reciprocal direction and `tmin`.
+    type RayRegisters = (Vec3A, Vec3A, f32);
+
+    #[inline(always)]
+    fn ray_registers(ray: &GRay<f32>) -> Self::RayRegisters {
+        (
+            Vec3A::from_array(ray.origin),
+            Vec3A::from_array(ray.inv_dir),
+            ray.tmin,
+        )
+    }
+
+    #[inline(always)]
+    fn split_test(
+        &mut self,
+        dir: Split,
+        &(origin, inv_dir, tmin): &Self::RayRegisters,
+        tmax: f32,
+    ) -> (Self, ChildTests) {
+        let upper = self.split_in_place(dir);
+        let tests = N::bounds_pair(self, &upper).map(|(min, max)| {
+            let hit = slab(min, max, origin, inv_dir, tmin, tmax).map(|(t, _)| t);
+            (
+                GBox {
+                    min: min.to_array(),
+                    max: max.to_array(),
+                },
+                hit,
+            )
+        });
+        (upper, tests)
+    }
+
+    #[inline(always)]
+    fn corners(&self) -> Corners<f32> {
+        LaneNet::corners(self)
+    }
+}
+
 /// Horizontal reduction of three registers with `f` (lane-wise min or max) into the lanes
 /// x, y, z of one: a 4×4 transpose and two lane-wise steps instead of three separate
 /// two-shuffle reductions and their scalar extractions.
@@ -54,7 +115,8 @@ pub fn reduce3(a: Vec4, b: Vec4, c: Vec4, f: impl Fn(Vec4, Vec4) -> Vec4) -> Vec
 /// The current net and the pending upper child of the last split by value (in registers
 /// where the compiler can keep them); the pushed nets in `slots[..top]`. A split writes the
 /// lower child over `cur`; pushing the farther child is one store of it, whichever it is.
-pub struct RegisterStack<'a, N> {
+pub struct RegisterStack<'a, N: RegisterNet> {
+    pub ray: N::RayRegisters,
     pub cur: N,
     pub pending: N,
     pub slots: &'a mut Vec<N>,
@@ -64,8 +126,9 @@ pub struct RegisterStack<'a, N> {
 impl<'a, N: RegisterNet> RegisterStack<'a, N> {
     /// A stack holding only `root`; `slots` is reused scratch.
     #[inline(always)]
-    pub fn new(root: N, slots: &'a mut Vec<N>) -> Self {
+    pub fn new(root: N, ray: &GRay<f32>, slots: &'a mut Vec<N>) -> Self {
         RegisterStack {
+            ray: N::ray_registers(ray),
             cur: root,
             pending: root,
             slots,
@@ -81,27 +144,10 @@ impl<N: RegisterNet> NetStack<f32> for RegisterStack<'_, N> {
     }
 
     #[inline(always)]
-    fn split_test(
-        &mut self,
-        dir: Split,
-        ray: &GRay<f32>,
-        tmax: f32,
-    ) -> [(GBox<f32>, Option<f32>); 2] {
-        self.pending = self.cur.split_in_place(dir);
-        let (origin, inv_dir) = (
-            Vec3A::from_array(ray.origin),
-            Vec3A::from_array(ray.inv_dir),
-        );
-        N::bounds_pair(&self.cur, &self.pending).map(|(min, max)| {
-            let hit = slab(min, max, origin, inv_dir, ray.tmin, tmax).map(|(t, _)| t);
-            (
-                GBox {
-                    min: min.to_array(),
-                    max: max.to_array(),
-                },
-                hit,
-            )
-        })
+    fn split_test(&mut self, dir: Split, _ray: &GRay<f32>, tmax: f32) -> ChildTests {
+        let tests;
+        (self.pending, tests) = self.cur.split_test(dir, &self.ray, tmax);
+        tests
     }
 
     #[inline(always)]
@@ -175,7 +221,7 @@ fn search_portable<N: RegisterNet>(
     any_hit: bool,
     stats: &mut KernelStats,
 ) -> Option<SearchHit<f32>> {
-    let mut nets = RegisterStack::new(net, slots);
+    let mut nets = RegisterStack::new(net, ray, slots);
     search(&mut nets, nodes, root, ray, false, cfg, any_hit, stats)
 }
 
