@@ -21,12 +21,13 @@
 use std::arch::x86_64::*;
 
 use super::bicubic::Net;
-use super::config::SubdivisionConfig;
+use super::config::{SubdivisionConfig, Termination};
 use super::float::{GBox, GRay};
 use super::heuristics::Corners;
 use super::param::Split;
+use super::ray_space::{MIN_RAY_SPACE_SCALE, RayFrame, cell_box};
 use super::register::{ChildTests, RegisterNet, RegisterStack};
-use super::search::{Node, SearchHit, search};
+use super::search::{Node, SearchHit, end_game_diameter, search};
 use crate::geom::bbox::SLAB_FAR_SCALE;
 use crate::kernel::KernelStats;
 
@@ -50,14 +51,28 @@ pub struct Net16 {
 const PAD_LANES: __mmask16 = 0x8888;
 const UPPER_HALF: __mmask16 = 0xFF00;
 
-/// The ray as the slab test needs it: origin and reciprocal direction repeated in every
-/// quarter (x, y, z, 0), and `tmin`.
+/// The ray as the box tests need it.
 #[derive(Clone, Copy, Debug)]
-pub struct Ray16 {
-    origin: __m512,
-    inv_dir: __m512,
-    tmin: f32,
+pub enum Ray16 {
+    /// World space: the slab test, with origin and reciprocal direction repeated in every
+    /// quarter (x, y, z, 0).
+    Slab {
+        origin: __m512,
+        inv_dir: __m512,
+        tmin: f32,
+    },
+    /// Ray space ([`super::ray_space`]), the ray the z-axis: a box is hit when its x and
+    /// y ranges hold 0 and its z range meets `[tmin, tmax]`. `bounds` is what the boxes
+    /// of [`slab_pair`]'s regrouped layout, maxima negated, must not exceed: x, y 0, z
+    /// `tmax` (filled in per test) for the minima, `-tmin` for the negated maxima.
+    Axis { bounds: __m512, tmin: f32 },
 }
+
+/// Lanes of the regrouped boxes holding the lower and the upper child's x, y, z bounds.
+const LOWER_XYZ: __mmask16 = 0x0707;
+const UPPER_XYZ: __mmask16 = 0x7070;
+/// Lanes of the minima's z, where [`Ray16::Axis`] takes `tmax`.
+const MIN_Z: __mmask16 = 0x0044;
 
 impl Net16 {
     /// The SSE net's points, re-laid out.
@@ -76,10 +91,60 @@ impl Net16 {
         }
     }
 
+    /// The net with every point in the ray space of `frame`: `(p - o)` and then the three
+    /// axes' dot products, the same operations for every point, so shared edge points
+    /// stay bit-identical (see [`super::ray_space`]).
+    #[target_feature(enable = "avx512f")]
+    fn to_ray_space(&self, frame: &RayFrame) -> Net16 {
+        // Quarter r of the result holds v[r] in every lane (coordinate r of four points).
+        let per_quarter = |v: [f32; 3]| {
+            _mm512_setr_ps(
+                v[0], v[0], v[0], v[0], v[1], v[1], v[1], v[1], v[2], v[2], v[2], v[2], 0.0, 0.0,
+                0.0, 0.0,
+            )
+        };
+        let origin = per_quarter(frame.origin);
+        let a = frame.axes;
+        let (ax, ay, az) = (
+            per_quarter([a[0][0], a[1][0], a[2][0]]),
+            per_quarter([a[0][1], a[1][1], a[2][1]]),
+            per_quarter([a[0][2], a[1][2], a[2][2]]),
+        );
+        let regs = self.regs.map(|r| {
+            let d = _mm512_sub_ps(r, origin);
+            let x = _mm512_shuffle_f32x4::<0x00>(d, d);
+            let y = _mm512_shuffle_f32x4::<0x55>(d, d);
+            let z = _mm512_shuffle_f32x4::<0xAA>(d, d);
+            _mm512_add_ps(
+                _mm512_add_ps(_mm512_mul_ps(ax, x), _mm512_mul_ps(ay, y)),
+                _mm512_mul_ps(az, z),
+            )
+        });
+        Net16 { regs, ..*self }
+    }
+
+    /// The control box of the net.
+    #[target_feature(enable = "avx512f")]
+    fn bounds(&self) -> GBox<f32> {
+        child_boxes(by_bound(boxes(&self.regs, &self.regs)))[0]
+    }
+
     fn lanes(v: __m512) -> [f32; 16] {
         // SAFETY: __m512 and [f32; 16] have the same size, and every bit pattern is an f32.
         unsafe { std::mem::transmute(v) }
     }
+}
+
+/// `v` in lanes 0..3 of every quarter, `pad` in lane 3.
+#[target_feature(enable = "avx512f")]
+#[inline]
+fn quarters(v: [f32; 3], pad: f32) -> __m512 {
+    let mut l = [pad; 16];
+    for q in 0..4 {
+        l[4 * q..4 * q + 3].copy_from_slice(&v);
+    }
+    // SAFETY: 16 f32s, read unaligned.
+    unsafe { _mm512_loadu_ps(l.as_ptr()) }
 }
 
 /// Transposes the four 4×4 blocks (one per quarter) of four registers: the SSE 4×4
@@ -139,17 +204,60 @@ fn boxes(lo: &[__m512; 4], hi: &[__m512; 4]) -> __m512 {
     _mm512_shuffle_ps::<0x88>(mins, maxs)
 }
 
-/// The slab test of [`crate::geom::bbox::slab`] for both boxes of `b` (the layout of
-/// [`boxes`]): the entry parameters `[lower, upper]` where the ray hits, and the boxes.
+/// The boxes of [`boxes`] regrouped to quarters `[lower min, upper min, lower max, upper
+/// max]`, lanes x, y, z, 0.
 #[target_feature(enable = "avx512f")]
 #[inline]
-fn slab_pair(b: __m512, ray: &Ray16, tmax: f32) -> ChildTests {
-    // Regroup to quarters [lower min, upper min, lower max, upper max], lanes x, y, z, 0.
-    let by_bound = _mm512_permutexvar_ps(
+fn by_bound(b: __m512) -> __m512 {
+    _mm512_permutexvar_ps(
         _mm512_setr_epi32(0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15),
         b,
-    );
-    let t = _mm512_mul_ps(_mm512_sub_ps(by_bound, ray.origin), ray.inv_dir);
+    )
+}
+
+/// The two children's boxes from the regrouped layout of [`by_bound`].
+fn child_boxes(by_bound: __m512) -> [GBox<f32>; 2] {
+    let l = Net16::lanes(by_bound);
+    std::array::from_fn(|k| GBox {
+        min: [l[4 * k], l[4 * k + 1], l[4 * k + 2]],
+        max: [l[8 + 4 * k], l[9 + 4 * k], l[10 + 4 * k]],
+    })
+}
+
+/// The ray-space test of [`Ray16::Axis`] for both boxes of [`by_bound`]'s layout. Exact:
+/// comparisons only, no rounding.
+#[target_feature(enable = "avx512f")]
+#[inline]
+fn axis_pair(by_bound: __m512, bounds: __m512, tmin: f32, tmax: f32) -> ChildTests {
+    let negated_max = _mm512_mask_sub_ps(by_bound, UPPER_HALF, _mm512_setzero_ps(), by_bound);
+    let bounds = _mm512_mask_blend_ps(MIN_Z, bounds, _mm512_set1_ps(tmax));
+    let inside = _mm512_cmp_ps_mask::<_CMP_LE_OQ>(negated_max, bounds);
+    let l = Net16::lanes(by_bound);
+    let [lower, upper] = child_boxes(by_bound);
+    [
+        (
+            lower,
+            (inside & LOWER_XYZ == LOWER_XYZ).then(|| l[2].max(tmin)),
+        ),
+        (
+            upper,
+            (inside & UPPER_XYZ == UPPER_XYZ).then(|| l[6].max(tmin)),
+        ),
+    ]
+}
+
+/// The slab test of [`crate::geom::bbox::slab`] for both boxes of [`by_bound`]'s layout:
+/// the entry parameters `[lower, upper]` where the ray hits, and the boxes.
+#[target_feature(enable = "avx512f")]
+#[inline]
+fn slab_pair(
+    by_bound: __m512,
+    origin: __m512,
+    inv_dir: __m512,
+    tmin: f32,
+    tmax: f32,
+) -> ChildTests {
+    let t = _mm512_mul_ps(_mm512_sub_ps(by_bound, origin), inv_dir);
     // Each min against its max: quarters swapped pairwise.
     let other = _mm512_shuffle_f32x4::<0x4E>(t, t);
     let nan = _mm512_cmp_ps_mask::<_CMP_UNORD_Q>(t, other);
@@ -170,15 +278,11 @@ fn slab_pair(b: __m512, ray: &Ray16, tmax: f32) -> ChildTests {
     let m = _mm512_max_ps(m, _mm512_shuffle_ps::<0xB1>(m, m));
     let m = _mm512_max_ps(m, _mm512_shuffle_ps::<0x4E>(m, m));
     let l = Net16::lanes(m);
-    let bounds = Net16::lanes(by_bound);
+    let boxes = child_boxes(by_bound);
     std::array::from_fn(|k| {
-        let enter = l[4 * k].max(ray.tmin);
+        let enter = l[4 * k].max(tmin);
         let exit = (-l[8 + 4 * k]).min(tmax);
-        let gbox = GBox {
-            min: [bounds[4 * k], bounds[4 * k + 1], bounds[4 * k + 2]],
-            max: [bounds[8 + 4 * k], bounds[9 + 4 * k], bounds[10 + 4 * k]],
-        };
-        (gbox, (enter <= exit).then_some(enter))
+        (boxes[k], (enter <= exit).then_some(enter))
     })
 }
 
@@ -187,19 +291,14 @@ impl RegisterNet for Net16 {
 
     #[inline(always)]
     fn ray_registers(ray: &GRay<f32>) -> Ray16 {
-        let quarters = |v: [f32; 3]| {
-            let mut l = [0f32; 16];
-            for q in 0..4 {
-                l[4 * q..4 * q + 3].copy_from_slice(&v);
+        // SAFETY: AVX-512 is available wherever a Net16 exists (one is only built by
+        // `search_net16`, behind `available`).
+        unsafe {
+            Ray16::Slab {
+                origin: quarters(ray.origin, 0.0),
+                inv_dir: quarters(ray.inv_dir, 0.0),
+                tmin: ray.tmin,
             }
-            // SAFETY: 16 f32s, read unaligned; AVX-512 is available wherever a Net16
-            // exists (it is only built by `search`, behind `available`).
-            unsafe { _mm512_loadu_ps(l.as_ptr()) }
-        };
-        Ray16 {
-            origin: quarters(ray.origin),
-            inv_dir: quarters(ray.inv_dir),
-            tmin: ray.tmin,
         }
     }
 
@@ -218,7 +317,15 @@ impl RegisterNet for Net16 {
             };
             let (lo, hi) = split4(regs);
             self.regs = lo;
-            let tests = slab_pair(boxes(&lo, &hi), ray, tmax);
+            let b = by_bound(boxes(&lo, &hi));
+            let tests = match *ray {
+                Ray16::Slab {
+                    origin,
+                    inv_dir,
+                    tmin,
+                } => slab_pair(b, origin, inv_dir, tmin, tmax),
+                Ray16::Axis { bounds, tmin } => axis_pair(b, bounds, tmin, tmax),
+            };
             (
                 Net16 {
                     regs: hi,
@@ -281,7 +388,41 @@ fn search_avx512(
     any_hit: bool,
     stats: &mut KernelStats,
 ) -> Option<SearchHit<f32>> {
-    let mut nets = RegisterStack::new(Net16::from_net(net), ray, slots);
+    let world = Net16::from_net(net);
+    if cfg.ray_space && cfg.termination == Termination::Float {
+        let frame = RayFrame::new(ray);
+        let local = world.to_ray_space(&frame);
+        let local_root = local.bounds();
+        let scale = (0..3).fold(0f32, |a, i| {
+            a.max(-local_root.min[i]).max(local_root.max[i])
+        });
+        if scale >= MIN_RAY_SPACE_SCALE {
+            let axis = frame.axis_ray(ray);
+            let (inf, lo) = (f32::INFINITY, -ray.tmin);
+            let registers = Ray16::Axis {
+                bounds: _mm512_setr_ps(
+                    0.0, 0.0, 0.0, inf, 0.0, 0.0, 0.0, inf, 0.0, 0.0, lo, inf, 0.0, 0.0, lo, inf,
+                ),
+                tmin: ray.tmin,
+            };
+            let floor = frame.world_length(end_game_diameter(&root, cfg.end_ulps));
+            let mut nets = RegisterStack::with_registers(local, registers, floor, slots);
+            let hit = search(
+                &mut nets, nodes, local_root, &axis, false, cfg, any_hit, stats,
+            )?;
+            if any_hit {
+                // `occluded` needs no hit box.
+                return Some(hit);
+            }
+            let rows: [[[f32; 3]; 4]; 4] =
+                std::array::from_fn(|j| std::array::from_fn(|i| net.point(i, j)));
+            return Some(SearchHit {
+                bbox: cell_box(&rows, hit.cell),
+                ..hit
+            });
+        }
+    }
+    let mut nets = RegisterStack::new(world, ray, slots);
     search(&mut nets, nodes, root, ray, false, cfg, any_hit, stats)
 }
 
@@ -308,20 +449,8 @@ mod tests {
         BezierPatch::from_points(3, 3, &pts).unwrap()
     }
 
-    /// The AVX-512 net must give exactly the SSE net's search (the same splits, the same
-    /// boxes, the same hits): both are the same arithmetic in another register layout.
-    #[test]
-    fn avx512_search_is_bit_identical_to_the_sse_search() {
-        if !available() {
-            eprintln!("skipped: this CPU has no AVX-512F");
-            return;
-        }
-        let net = Net::from_patch(&patch());
-        let root = GBox {
-            min: [-1.0, -2.5, -1.5],
-            max: [5.5, 3.5, 1.5],
-        };
-        let cfg = SubdivisionConfig::default();
+    /// Random rays from above aimed at the patch's neighbourhood, by a fixed xorshift32.
+    fn rays() -> Vec<GRay<f32>> {
         let mut state = 0x2545_f491u32;
         let mut uniform = || {
             state ^= state << 13;
@@ -329,30 +458,54 @@ mod tests {
             state ^= state << 5;
             (state >> 8) as f32 / (1u32 << 24) as f32
         };
+        (0..2000)
+            .map(|_| {
+                let target = [6.0 * uniform() - 0.5, 5.0 * uniform() - 2.0, 0.0];
+                let origin = [
+                    8.0 * uniform() - 4.0,
+                    8.0 * uniform() - 4.0,
+                    6.0 + 4.0 * uniform(),
+                ];
+                let dir = [0, 1, 2].map(|c| target[c] - origin[c]);
+                GRay::new(origin, dir, 0.0, f32::INFINITY)
+            })
+            .collect()
+    }
+
+    const ROOT: GBox<f32> = GBox {
+        min: [-1.0, -2.5, -1.5],
+        max: [5.5, 3.5, 1.5],
+    };
+
+    /// In world space the AVX-512 net must give exactly the SSE net's search (the same
+    /// splits, the same boxes, the same hits): the same arithmetic in another layout.
+    #[test]
+    fn world_space_search_is_bit_identical_to_the_sse_search() {
+        if !available() {
+            eprintln!("skipped: this CPU has no AVX-512F");
+            return;
+        }
+        let net = Net::from_patch(&patch());
+        let cfg = SubdivisionConfig {
+            ray_space: false,
+            ..SubdivisionConfig::default()
+        };
         let (mut hits, mut slots16, mut slots, mut nodes) = (0, Vec::new(), Vec::new(), Vec::new());
-        for _ in 0..2000 {
-            let target = [6.0 * uniform() - 0.5, 5.0 * uniform() - 2.0, 0.0];
-            let origin = [
-                8.0 * uniform() - 4.0,
-                8.0 * uniform() - 4.0,
-                6.0 + 4.0 * uniform(),
-            ];
-            let dir = [0, 1, 2].map(|c| target[c] - origin[c]);
+        for ray in rays() {
             for any_hit in [false, true] {
-                let ray = GRay::new(origin, dir, 0.0, f32::INFINITY);
                 let (mut s16, mut s) = (KernelStats::default(), KernelStats::default());
                 let a = search_net16(
                     &net,
                     &mut slots16,
                     &mut nodes,
-                    root,
+                    ROOT,
                     &ray,
                     &cfg,
                     any_hit,
                     &mut s16,
                 );
                 let b = search_register(
-                    net, &mut slots, &mut nodes, root, &ray, &cfg, any_hit, &mut s,
+                    net, &mut slots, &mut nodes, ROOT, &ray, &cfg, any_hit, &mut s,
                 );
                 assert_eq!(
                     a.map(|h| (h.t, h.cell, h.bbox)),
@@ -364,5 +517,56 @@ mod tests {
         }
         // Most rays aim at the patch's parameter-space footprint: the test must see hits.
         assert!(hits > 1000, "{hits} hits");
+    }
+
+    /// In ray space the search finds the same crossings as in world space: the same rays
+    /// hit, the world hit box (from the final cell) holds the ray-space hit point up to the
+    /// end game, and the two `t` differ by no more than the two final boxes' extents.
+    #[test]
+    fn ray_space_search_finds_the_world_space_hits() {
+        if !available() {
+            eprintln!("skipped: this CPU has no AVX-512F");
+            return;
+        }
+        let net = Net::from_patch(&patch());
+        let world_cfg = SubdivisionConfig {
+            ray_space: false,
+            ..SubdivisionConfig::default()
+        };
+        let cfg = SubdivisionConfig::default();
+        let (mut slots, mut nodes, mut stats) = (Vec::new(), Vec::new(), KernelStats::default());
+        let mut search = |ray: &GRay<f32>, cfg: &SubdivisionConfig| {
+            search_net16(
+                &net, &mut slots, &mut nodes, ROOT, ray, cfg, false, &mut stats,
+            )
+        };
+        let mut hits = 0;
+        for ray in rays() {
+            let (a, b) = (search(&ray, &cfg), search(&ray, &world_cfg));
+            assert_eq!(a.is_some(), b.is_some(), "{ray:?}");
+            let (Some(a), Some(b)) = (a, b) else { continue };
+            hits += 1;
+            // The length of the ray's parameter interval inside a hit box.
+            let extent = |h: &SearchHit<f32>| {
+                (0..3)
+                    .map(|c| (h.bbox.max[c] - h.bbox.min[c]) * ray.inv_dir[c].abs())
+                    .fold(f32::INFINITY, f32::min)
+            };
+            // 16 ulps of the scale of t, for the end game of both.
+            let slack = 16.0 * f32::EPSILON * a.t.max(b.t);
+            assert!(
+                (a.t - b.t).abs() <= extent(&a) + extent(&b) + slack,
+                "{a:?} vs {b:?}"
+            );
+            let p: [f32; 3] = std::array::from_fn(|c| ray.origin[c] + a.t * ray.dir[c]);
+            for c in 0..3 {
+                let pad = extent(&a) * ray.dir[c].abs() + slack * 8.0;
+                assert!(
+                    p[c] >= a.bbox.min[c] - pad && p[c] <= a.bbox.max[c] + pad,
+                    "{a:?}"
+                );
+            }
+        }
+        assert!(hits > 500, "{hits} hits");
     }
 }

@@ -83,6 +83,12 @@ pub struct SubdivisionConfig {
     /// End-game criterion in ulps of the root box's largest coordinate magnitude; 0
     /// disables it.
     pub end_ulps: u32,
+    /// Search bicubic patches in the ray's own frame ([`super::ray_space`]) where the
+    /// fast path supports it. A property of the ray, so that every patch a ray meets is
+    /// searched in the same space: on for primary rays, off for secondary rays
+    /// ([`SubdivisionConfig::for_secondary_rays`]), whose origins are corners of
+    /// world-space hit boxes (Dammertz §2.4).
+    pub ray_space: bool,
 }
 
 impl Default for SubdivisionConfig {
@@ -92,6 +98,7 @@ impl Default for SubdivisionConfig {
             termination: Termination::Float,
             rational_dist: DEFAULT_RATIONAL_DIST,
             end_ulps: DEFAULT_END_ULPS,
+            ray_space: true,
         }
     }
 }
@@ -99,14 +106,17 @@ impl Default for SubdivisionConfig {
 impl SubdivisionConfig {
     /// The configuration for secondary rays: adaptive termination is defined by the
     /// camera's pixels and so only for primary rays (§2.5.3, "this simple projection does
-    /// not work for secondary rays"); they fall back to float precision.
+    /// not work for secondary rays"); they fall back to float precision. They search in
+    /// world space (see [`SubdivisionConfig::ray_space`]).
     pub fn for_secondary_rays(self) -> SubdivisionConfig {
-        match self.termination {
-            Termination::Adaptive(_) => SubdivisionConfig {
-                termination: Termination::Float,
-                ..self
-            },
-            _ => self,
+        let termination = match self.termination {
+            Termination::Adaptive(_) => Termination::Float,
+            other => other,
+        };
+        SubdivisionConfig {
+            termination,
+            ray_space: false,
+            ..self
         }
     }
 }
@@ -135,6 +145,7 @@ mod tests {
             termination: Termination::Depth(12),
             ..SubdivisionConfig::default()
         };
-        assert_eq!(depth.for_secondary_rays(), depth);
+        assert_eq!(depth.for_secondary_rays().termination, depth.termination);
+        assert!(depth.ray_space && !depth.for_secondary_rays().ray_space);
     }
 }

@@ -27,6 +27,7 @@ pub mod general;
 pub mod heuristics;
 pub mod param;
 pub mod prepared;
+pub mod ray_space;
 pub mod reference;
 pub mod register;
 pub mod search;

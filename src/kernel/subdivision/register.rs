@@ -117,6 +117,8 @@ pub fn reduce3(a: Vec4, b: Vec4, c: Vec4, f: impl Fn(Vec4, Vec4) -> Vec4) -> Vec
 /// lower child over `cur`; pushing the farther child is one store of it, whichever it is.
 pub struct RegisterStack<'a, N: RegisterNet> {
     pub ray: N::RayRegisters,
+    /// See [`NetStack::end_game_floor`].
+    pub end_game_floor: f32,
     pub cur: N,
     pub pending: N,
     pub slots: &'a mut Vec<N>,
@@ -127,8 +129,21 @@ impl<'a, N: RegisterNet> RegisterStack<'a, N> {
     /// A stack holding only `root`; `slots` is reused scratch.
     #[inline(always)]
     pub fn new(root: N, ray: &GRay<f32>, slots: &'a mut Vec<N>) -> Self {
+        Self::with_registers(root, N::ray_registers(ray), 0.0, slots)
+    }
+
+    /// A stack holding only `root`, testing boxes with `ray` (in whatever frame the nets
+    /// are) and ending the end game at `end_game_floor` at the latest.
+    #[inline(always)]
+    pub fn with_registers(
+        root: N,
+        ray: N::RayRegisters,
+        end_game_floor: f32,
+        slots: &'a mut Vec<N>,
+    ) -> Self {
         RegisterStack {
-            ray: N::ray_registers(ray),
+            ray,
+            end_game_floor,
             cur: root,
             pending: root,
             slots,
@@ -177,6 +192,10 @@ impl<N: RegisterNet> NetStack<f32> for RegisterStack<'_, N> {
             self.top = top;
             self.cur = self.slots[top];
         }
+    }
+
+    fn end_game_floor(&self) -> f32 {
+        self.end_game_floor
     }
 }
 

@@ -30,6 +30,12 @@ pub trait NetStack<T: KernelFloat> {
     fn keep(&mut self, lower: bool);
     /// Drop the current net and continue with the most recently pushed one.
     fn pop(&mut self);
+    /// An L1 diameter below which boxes are rounding noise of the net the stack's nets
+    /// came from (a net transformed into another frame is no more precise than its
+    /// source): the end game stops there at the latest. Zero for nets searched as built.
+    fn end_game_floor(&self) -> T {
+        T::ZERO
+    }
 }
 
 /// What the search keeps per sub-patch besides its control net.
@@ -76,7 +82,7 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
     };
     let mut best: Option<SearchHit<T>> = None;
     let max = T::MAX_LEVEL;
-    let stop = Stop::new(cfg, &root, ray, rational);
+    let stop = Stop::new(cfg, &root, ray, rational, nets.end_game_floor());
     loop {
         // A popped entry was tested against an older, longer ray; after a hit only strictly
         // nearer boxes matter.
@@ -152,6 +158,20 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
     }
 }
 
+/// The end-game L1 diameter of a search from `root`: `end_ulps` ulps of the largest
+/// coordinate magnitude of the box (see [`Stop`]).
+pub fn end_game_diameter<T: KernelFloat>(root: &GBox<T>, end_ulps: u32) -> T {
+    let scale = (0..3)
+        .map(|i| {
+            root.min[i]
+                .max(-root.min[i])
+                .max(root.max[i])
+                .max(-root.max[i])
+        })
+        .fold(T::ZERO, |a, b| a.max(b));
+    (scale.next_up() - scale) * T::from_f64(end_ulps as f64)
+}
+
 /// The termination test of one search, with what depends only on the root box and the
 /// ray computed once.
 struct Stop<T> {
@@ -175,15 +195,13 @@ enum Criterion<T> {
 }
 
 impl<T: KernelFloat> Stop<T> {
-    fn new(cfg: &SubdivisionConfig, root: &GBox<T>, ray: &GRay<T>, rational: bool) -> Self {
-        let scale = (0..3)
-            .map(|i| {
-                root.min[i]
-                    .max(-root.min[i])
-                    .max(root.max[i])
-                    .max(-root.max[i])
-            })
-            .fold(T::ZERO, |a, b| a.max(b));
+    fn new(
+        cfg: &SubdivisionConfig,
+        root: &GBox<T>,
+        ray: &GRay<T>,
+        rational: bool,
+        floor: T,
+    ) -> Self {
         let criterion = match cfg.termination {
             Termination::Float => Criterion::Float,
             Termination::Depth(d) => Criterion::Depth(d),
@@ -195,7 +213,7 @@ impl<T: KernelFloat> Stop<T> {
             }
         };
         Stop {
-            end_diameter: (scale.next_up() - scale) * T::from_f64(cfg.end_ulps as f64),
+            end_diameter: end_game_diameter(root, cfg.end_ulps).max(floor),
             rational_dist: rational.then_some(cfg.rational_dist),
             criterion,
         }
