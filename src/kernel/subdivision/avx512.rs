@@ -95,7 +95,7 @@ impl Net16 {
     /// axes' dot products, the same operations for every point, so shared edge points
     /// stay bit-identical (see [`super::ray_space`]).
     #[target_feature(enable = "avx512f")]
-    fn to_ray_space(&self, frame: &RayFrame) -> Net16 {
+    fn in_ray_space(&self, frame: &RayFrame) -> Net16 {
         // Quarter r of the result holds v[r] in every lane (coordinate r of four points).
         let per_quarter = |v: [f32; 3]| {
             _mm512_setr_ps(
@@ -391,7 +391,7 @@ fn search_avx512(
     let world = Net16::from_net(net);
     if cfg.ray_space && cfg.termination == Termination::Float {
         let frame = RayFrame::new(ray);
-        let local = world.to_ray_space(&frame);
+        let local = world.in_ray_space(&frame);
         let local_root = local.bounds();
         let scale = (0..3).fold(0f32, |a, i| {
             a.max(-local_root.min[i]).max(local_root.max[i])
