@@ -25,7 +25,7 @@ use super::config::{SubdivisionConfig, Termination};
 use super::float::{GBox, GRay};
 use super::heuristics::Corners;
 use super::param::Split;
-use super::ray_space::{MIN_RAY_SPACE_SCALE, RayFrame, cell_box};
+use super::ray_space::{MIN_RAY_SPACE_SCALE, RayFrame};
 use super::register::{ChildTests, RegisterNet, RegisterStack};
 use super::search::{Node, SearchHit, end_game_diameter, search};
 use crate::geom::bbox::SLAB_FAR_SCALE;
@@ -231,18 +231,17 @@ fn child_boxes(by_bound: __m512) -> [GBox<f32>; 2] {
 fn axis_pair(by_bound: __m512, bounds: __m512, tmin: f32, tmax: f32) -> ChildTests {
     let negated_max = _mm512_mask_sub_ps(by_bound, UPPER_HALF, _mm512_setzero_ps(), by_bound);
     let bounds = _mm512_mask_blend_ps(MIN_Z, bounds, _mm512_set1_ps(tmax));
-    let inside = _mm512_cmp_ps_mask::<_CMP_LE_OQ>(negated_max, bounds);
+    // The bits a child needs that are missing from the mask, in a general-purpose
+    // register: tested as a 16-bit vector, the compiler went through memory (a
+    // store-forwarding stall that cost a sixth of the search's time).
+    let outside = !u32::from(_mm512_cmp_ps_mask::<_CMP_LE_OQ>(negated_max, bounds));
     let l = Net16::lanes(by_bound);
     let [lower, upper] = child_boxes(by_bound);
+    let lower_hit = outside & u32::from(LOWER_XYZ) == 0;
+    let upper_hit = outside & u32::from(UPPER_XYZ) == 0;
     [
-        (
-            lower,
-            (inside & LOWER_XYZ == LOWER_XYZ).then(|| l[2].max(tmin)),
-        ),
-        (
-            upper,
-            (inside & UPPER_XYZ == UPPER_XYZ).then(|| l[6].max(tmin)),
-        ),
+        (lower, lower_hit.then(|| l[2].max(tmin))),
+        (upper, upper_hit.then(|| l[6].max(tmin))),
     ]
 }
 
@@ -414,10 +413,8 @@ fn search_avx512(
                 // `occluded` needs no hit box.
                 return Some(hit);
             }
-            let rows: [[[f32; 3]; 4]; 4] =
-                std::array::from_fn(|j| std::array::from_fn(|i| net.point(i, j)));
             return Some(SearchHit {
-                bbox: cell_box(&rows, hit.cell),
+                bbox: frame.world_box(&hit.bbox, scale),
                 ..hit
             });
         }

@@ -32,23 +32,24 @@
 //! search never refines below the precision of the net it came from.
 //!
 //! Hit box. Secondary rays start from a corner of the world-space box of the hit (§2.4),
-//! which must contain the surface piece. It is computed once at the end from the final
-//! parameter cell ([`cell_box`]): the world `f32` net restricted to the cell in `f64` (two
-//! de Casteljau steps per direction), padded by a bound on the `f64` rounding and rounded
-//! outward to `f32`. By the convex hull property it contains the `f32` net's surface over
-//! the cell.
+//! which must contain the surface piece. It is the final ray-space box mapped back to world
+//! space ([`RayFrame::world_box`]) in `f64`, grown by a bound on the rounding of the
+//! transform and of the ray-space net ([`TRANSFORM_ULPS`]) and rounded outward. (Restricting
+//! the world net to the final parameter cell in `f64` gives a tighter box but cost a sixth
+//! of the kernel's time on the teapot.)
 
 use glam::DVec3;
 
 use super::float::{GBox, GRay};
-use super::param::ParamCell;
 use crate::geom::DAabb;
 
-/// Relative `f64` rounding bound of [`cell_box`], in units of `f64::EPSILON` times the
-/// largest coordinate magnitude: four de Casteljau passes of at most 3 levels (degree ≤ 3),
-/// each level one rounded multiply-add pair (≤ 2 eps); 64 leaves a factor of 2.6 of room
-/// and is still 2^-46, far below one `f32` ulp (2^-23).
-const CELL_BOX_PAD_EPS: f64 = 64.0;
+/// How far, in `f32` ulps of the ray-space coordinate scale, the ray-space net's
+/// surface can lie from the exactly transformed world net's: each point is `(p - o)` (one
+/// rounding) and a three-term dot product (three products, two sums), at most 3.5 ulps of
+/// the coordinate scale for an axis of norm `1 / |d|` applied to `|p - o|`, plus the
+/// de Casteljau rounding of the ray-space splits (measured below 0.4 ulp for the world
+/// nets, `super::NET_ROUNDING_ULPS`). 8 leaves room above 3.5 + 2.
+pub const TRANSFORM_ULPS: f64 = 8.0;
 
 /// Smallest ray-space coordinate scale (the largest magnitude of the patch's ray-space
 /// box) searched in ray space: 2^-39, so that an edge of one ulp of that scale (2^-63)
@@ -66,6 +67,8 @@ pub struct RayFrame {
     pub axes: [[f32; 3]; 3],
     /// `1 / |d|`: a world length times this is a ray-space length.
     inv_len: f32,
+    /// The inverse transform's columns `|d| e1`, `|d| e2`, `d`, in `f64`.
+    inverse: [DVec3; 3],
 }
 
 impl RayFrame {
@@ -85,6 +88,7 @@ impl RayFrame {
             origin: ray.origin,
             axes: [e1, e2, e3].map(|e| e.as_vec3().to_array()),
             inv_len: (1.0 / len) as f32,
+            inverse: [e1 * len2, e2 * len2, d],
         }
     }
 
@@ -93,64 +97,40 @@ impl RayFrame {
         GRay::new([0.0; 3], [0.0, 0.0, 1.0], ray.tmin, ray.tmax)
     }
 
+    /// The world box holding a ray-space box `local` of a net whose ray-space coordinates
+    /// are at most `scale` in magnitude: see the module documentation.
+    pub fn world_box(&self, local: &GBox<f32>, scale: f32) -> GBox<f32> {
+        let to_world = |v: [f32; 3]| DVec3::from_array(v.map(f64::from));
+        let (lo, hi) = (to_world(local.min), to_world(local.max));
+        let (centre, half) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
+        // Columns of the inverse frame: `p - o = |d| (x e1 + y e2) + z d`.
+        let columns = [self.inverse[0], self.inverse[1], self.inverse[2]];
+        let mut mid = DVec3::from_array(self.origin.map(f64::from));
+        let mut reach = DVec3::ZERO;
+        for (c, col) in columns.iter().enumerate() {
+            mid += *col * centre[c];
+            reach += col.abs() * half[c];
+        }
+        let err = TRANSFORM_ULPS * crate::geom::ulp::ulp_of(scale) / self.inv_len as f64;
+        let pad = reach + DVec3::splat(err * 3f64.sqrt());
+        GBox::from_aabb(
+            DAabb {
+                min: mid - pad,
+                max: mid + pad,
+            }
+            .to_f32_outward(),
+        )
+    }
+
     /// A world length in ray-space units.
     pub fn world_length(&self, world: f32) -> f32 {
         world * self.inv_len
     }
 }
 
-/// The world box of the net `rows` (`rows[j][i]` the point (i, j), degree `M - 1` in both
-/// directions) restricted to `cell`: see the module documentation.
-pub fn cell_box<const M: usize>(rows: &[[[f32; 3]; M]; M], cell: ParamCell) -> GBox<f32> {
-    let (u0, v0, wu, wv) = cell.bounds();
-    let mut net = rows.map(|row| row.map(|p| DVec3::from_array(p.map(f64::from))));
-    let scale = net
-        .iter()
-        .flatten()
-        .fold(0f64, |a, p| a.max(p.abs().max_element()));
-    for row in net.iter_mut() {
-        restrict(row, u0, wu);
-    }
-    for i in 0..M {
-        let mut col: [DVec3; M] = std::array::from_fn(|j| net[j][i]);
-        restrict(&mut col, v0, wv);
-        (0..M).for_each(|j| net[j][i] = col[j]);
-    }
-    let mut b = DAabb::EMPTY;
-    net.iter().flatten().for_each(|p| b.grow(*p));
-    let pad = DVec3::splat(CELL_BOX_PAD_EPS * f64::EPSILON * scale);
-    let padded = DAabb {
-        min: b.min - pad,
-        max: b.max + pad,
-    };
-    GBox::from_aabb(padded.to_f32_outward())
-}
-
-/// Replaces the control points of a Bézier curve over [0, 1] by those of its piece over
-/// `[a, a + w]`: de Casteljau at `a` keeping the upper part, then at `w / (1 - a)` keeping
-/// the lower.
-fn restrict<const M: usize>(c: &mut [DVec3; M], a: f64, w: f64) {
-    let n = M - 1;
-    // Upper part at a: c[i] becomes the level-(n - i) value at index i.
-    for r in 1..=n {
-        for i in 0..=n - r {
-            c[i] += a * (c[i + 1] - c[i]);
-        }
-    }
-    // Lower part at s: c[k] becomes the level-k value at index 0 (top down, in place).
-    let s = if a < 1.0 { w / (1.0 - a) } else { 1.0 };
-    for r in 1..=n {
-        for i in (r..=n).rev() {
-            c[i] = c[i - 1] + s * (c[i] - c[i - 1]);
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::BezierPatch;
-    use crate::kernel::subdivision::param::Split;
 
     #[test]
     fn ray_points_map_to_the_z_axis() {
@@ -166,49 +146,43 @@ mod tests {
         }
     }
 
+    /// The world box of a ray-space box holds every world point that maps into it.
     #[test]
-    fn cell_box_contains_the_surface_over_the_cell() {
-        let pts: Vec<DVec3> = (0..16)
-            .map(|k| {
-                let (i, j) = ((k % 4) as f64, (k / 4) as f64);
-                DVec3::new(i + 0.3 * j, j - 0.2 * i * i, (i - j).sin())
-            })
-            .collect();
-        let f32pts: Vec<[f32; 3]> = pts.iter().map(|q| q.as_vec3().to_array()).collect();
-        let cell = ParamCell::ROOT
-            .split(Split::U)
-            .1
-            .split(Split::V)
-            .0
-            .split(Split::U)
-            .0;
-        let rows: [[[f32; 3]; 4]; 4] =
-            std::array::from_fn(|j| std::array::from_fn(|i| f32pts[j * 4 + i]));
-        let b = cell_box(&rows, cell).to_aabb();
-        let (u0, v0, wu, wv) = cell.bounds();
-        // The surface of the f32 net (evaluated in f64) over the cell is inside; the
-        // cell covers an eighth of the parameter square, so the box is much smaller.
-        let f32_patch = BezierPatch::from_points(
-            3,
-            3,
-            &f32pts
-                .iter()
-                .map(|q| DVec3::from_array(q.map(f64::from)))
-                .collect::<Vec<_>>(),
-        )
-        .unwrap();
-        for a in 0..=8 {
-            for c in 0..=8 {
-                let q = f32_patch.eval(u0 + wu * a as f64 / 8.0, v0 + wv * c as f64 / 8.0);
-                for k in 0..3 {
-                    assert!(
-                        q[k] >= b.min[k] as f64 && q[k] <= b.max[k] as f64,
-                        "{q:?} {b:?}"
-                    );
-                }
+    fn world_box_holds_the_points_of_the_local_box() {
+        let ray = GRay::new([1.0, -2.0, 0.5], [0.3, 2.0, -0.7], 0.0, f32::INFINITY);
+        let f = RayFrame::new(&ray);
+        let local = GBox {
+            min: [-0.01, 0.02, 2.0],
+            max: [0.03, 0.05, 2.01],
+        };
+        let b = f.world_box(&local, 2.5);
+        let inverse = |q: [f64; 3]| {
+            let o = DVec3::from_array(f.origin.map(f64::from));
+            (0..3).fold(o, |p, c| p + f.inverse[c] * q[c])
+        };
+        let mut volume_corners = 0;
+        for k in 0..8 {
+            let q: [f64; 3] = std::array::from_fn(|c| {
+                let (lo, hi) = (local.min[c] as f64, local.max[c] as f64);
+                if k >> c & 1 == 0 { lo } else { hi }
+            });
+            let p = inverse(q);
+            for c in 0..3 {
+                assert!(
+                    p[c] >= b.min[c] as f64 && p[c] <= b.max[c] as f64,
+                    "{p:?} {b:?}"
+                );
             }
+            // And the forward transform of the world corner lands back on the local one.
+            let back: [f64; 3] = std::array::from_fn(|r| {
+                let a = DVec3::from_array(f.axes[r].map(f64::from));
+                a.dot(p - DVec3::from_array(f.origin.map(f64::from)))
+            });
+            volume_corners += (0..3).all(|c| (back[c] - q[c]).abs() < 1e-6) as usize;
         }
-        let whole = f32_patch.control_box();
-        assert!((b.max - b.min).element_sum() < 0.5 * (whole.max - whole.min).element_sum() as f32);
+        assert_eq!(volume_corners, 8);
+        // Not much bigger than the local box scaled by |d| (about 2.1 here).
+        let size: f32 = (0..3).map(|c| b.max[c] - b.min[c]).sum();
+        assert!(size < 0.25, "{b:?}");
     }
 }
