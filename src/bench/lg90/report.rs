@@ -186,8 +186,14 @@ pub fn markdown(results: &[CaseResult]) -> String {
             }
             s.push('\n');
         }
-        s.push_str(
-            "\nPer-ray rows are over all rays (the paper counts some only over rays that meet the scene's box or a surface); the paper's total rays are at 512².\n\n",
+        let clock = if result.runs.iter().all(|r| r.cpu) {
+            "CPU time of all threads"
+        } else {
+            "wall-clock time"
+        };
+        let _ = write!(
+            s,
+            "\nTimes are {clock}. Per-ray rows are over all rays (the paper counts some only over rays that meet the scene's box or a surface); the paper's total rays are at 512².\n\n",
         );
     }
     s
