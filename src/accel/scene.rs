@@ -47,16 +47,16 @@ impl Precision {
     }
 
     /// The path for secondary rays leaving `hit`: [`Precision::for_secondary_rays`], and
-    /// for the LG90 kernels the surface of origin, on which they apply the triviality
-    /// tests of §6.
+    /// for the LG90 kernels with ISRT (LG90 §6, "improved treatment of secondary rays")
+    /// the surface of origin, on which they apply the triviality tests.
     pub fn leaving(self, hit: &SceneHit) -> Precision {
         let origin = hit.primitive;
         match self.for_secondary_rays() {
-            Precision::Toth(cfg) => Precision::Toth(TothConfig {
+            Precision::Toth(cfg) if cfg.isrt => Precision::Toth(TothConfig {
                 surface_of_origin: origin,
                 ..cfg
             }),
-            Precision::Cached(mut cfg) => {
+            Precision::Cached(mut cfg) if cfg.toth.isrt => {
                 cfg.toth.surface_of_origin = origin;
                 Precision::Cached(cfg)
             }

@@ -255,8 +255,10 @@ pub struct KernelArgs {
     /// (Dammertz §2.7.2).
     #[arg(long, value_name = "ULPS")]
     pub rational_dist: Option<u32>,
-    /// Shadow rays stop at the first safe region, without Newton iteration (Lischinski &
-    /// Gonczarowski §6, the ISRT column). Only with `--kernel toth` or `--kernel cached`.
+    /// Improved treatment of secondary rays (Lischinski & Gonczarowski §6, the ISRT
+    /// column): the three triviality tests on the surface a secondary ray leaves, and
+    /// shadow rays stop at the first safe region, without Newton iteration. Only with
+    /// `--kernel toth` or `--kernel cached`.
     #[arg(long)]
     pub isrt: bool,
     /// Surface-tree cache of `--kernel cached` per worker thread, in MiB (Lischinski &

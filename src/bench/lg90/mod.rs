@@ -140,7 +140,9 @@ pub const METHODS: [Method; 5] = [
 
 impl Method {
     /// The kernel path this method runs; a cached method gets a fresh cache (a new
-    /// [`CachedConfig`] empties the workers' caches), so cases do not share trees.
+    /// [`CachedConfig`] empties the workers' caches), so cases do not share trees. The
+    /// cached methods include ISRT's treatment of secondary rays, as the paper's do (their
+    /// Newton starts per ray equal ISRT's in every table).
     pub fn precision(&self) -> Precision {
         let toth = |isrt| {
             Precision::Toth(TothConfig {
@@ -152,7 +154,10 @@ impl Method {
             MethodKernel::Toth => toth(false),
             MethodKernel::Isrt => toth(true),
             MethodKernel::Cached => Precision::Cached(CachedConfig::new(
-                TothConfig::default(),
+                TothConfig {
+                    isrt: true,
+                    ..TothConfig::default()
+                },
                 DEFAULT_CACHE_BYTES,
                 DEFAULT_MAX_DEPTH,
             )),

@@ -45,7 +45,9 @@ pub const DEFAULT_FINAL_ULPS: u32 = crate::kernel::subdivision::DEFAULT_END_ULPS
 /// Settings of the Toth kernel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TothConfig {
-    /// Shadow rays stop at the first safe region (LG90 §6, ISRT).
+    /// LG90 §6's improved treatment of secondary rays (ISRT): shadow rays stop at the
+    /// first safe region, and secondary rays get the triviality tests on their surface of
+    /// origin ([`crate::accel::scene::Precision::leaving`]).
     pub isrt: bool,
     /// Search iterations per ray–patch test.
     pub max_iterations: u32,
