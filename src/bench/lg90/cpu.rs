@@ -46,23 +46,20 @@ fn process_cpu_seconds() -> Option<f64> {
 mod tests {
     use super::*;
 
-    /// A busy loop of about 0.2 s of wall time shows as CPU time within the clock's tick
-    /// (a shared machine can only make CPU time smaller than wall time, never larger).
+    /// Busy work shows as CPU time that grows (other test threads of this process may add
+    /// to it, so only growth is checked), within a few seconds even on a loaded machine.
     #[test]
     fn busy_work_counts_as_cpu_time() {
         let w = Stopwatch::start();
         let wall = Instant::now();
         let mut x = 0u64;
-        while wall.elapsed().as_secs_f64() < 0.2 {
-            x = x.wrapping_mul(6364136223846793005).wrapping_add(1);
+        while w.seconds().0 <= 0.0 && wall.elapsed().as_secs_f64() < 5.0 {
+            for _ in 0..100_000 {
+                x = x.wrapping_mul(6364136223846793005).wrapping_add(1);
+            }
         }
         std::hint::black_box(x);
-        let (s, cpu) = w.seconds();
-        if cpu {
-            assert!(
-                s > 0.0 && s <= wall.elapsed().as_secs_f64() + 1.0 / USER_HZ,
-                "{s}"
-            );
-        }
+        let (s, _) = w.seconds();
+        assert!(s > 0.0, "{s}");
     }
 }
