@@ -9,7 +9,7 @@ use common::{render, run, stderr, stdout, testdata};
 const SIZE: u32 = 32;
 
 /// Rows every table must have, in the paper's wording.
-const ROWS: [&str; 11] = [
+const ROWS: [&str; 14] = [
     "normalized time",
     "surfaces tested / ray",
     "surfaces searched / ray",
@@ -20,6 +20,9 @@ const ROWS: [&str; 11] = [
     "av. width of safe regions",
     "cache misses / surface",
     "cache hit ratio",
+    "triviality test 1 (box) / ray",
+    "triviality test 2 (K) / ray",
+    "triviality test 3 (safe region) / ray",
     "total num. of rays",
 ];
 
@@ -99,13 +102,22 @@ fn tiny_lg90_table_has_every_row_and_agrees_with_render_stats() {
     );
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(1.0);
     assert!(close(
-        rays["patch_tests_per_ray"]["mean"].as_f64().unwrap(),
+        rays["surfaces_tested_per_ray"]["mean"].as_f64().unwrap(),
         csv_value(&csv, "TOTH", "surfaces tested / ray")
     ));
     assert!(close(
         rays["box_tests_per_ray"]["mean"].as_f64().unwrap(),
         csv_value(&csv, "TOTH", "ray-box tests / ray")
     ));
+    // LG90 §7.1: surfaces tested are the grid's outermost box tests; surfaces searched
+    // (every Toth call) are only those whose box the ray hits, so fewer.
+    let tested = rays["surfaces_tested_per_ray"]["mean"].as_f64().unwrap();
+    let searched = rays["toth"]["surfaces_searched_per_ray"].as_f64().unwrap();
+    assert!(close(
+        searched,
+        rays["patch_tests_per_ray"]["mean"].as_f64().unwrap()
+    ));
+    assert!(tested > searched, "tested {tested}, searched {searched}");
     assert!(close(
         rays["toth"]["search_iterations_per_ray"].as_f64().unwrap(),
         csv_value(&csv, "TOTH", "search iterations / ray")

@@ -15,7 +15,9 @@ use toth_common::{SILHOUETTE, agrees_with_reference, random_patch, random_ray};
 fn toth_agrees_with_the_f64_reference_on_random_patches() {
     let cfg = TothConfig::default();
     let mut stats = KernelStats::default();
-    let a = agrees_with_reference(6, 40, |patch, ray| intersect(patch, ray, &cfg, &mut stats));
+    let a = agrees_with_reference(6, 40, |patch, ray| {
+        intersect(patch, ray, &cfg, false, &mut stats)
+    });
     assert!(
         a.hits > 600 && a.misses > 300,
         "{} hits, {} misses of {}",
@@ -43,8 +45,8 @@ fn isrt_shadow_answers_match_full_shadow_tests() {
             let (mut ray, o, d) = random_ray(&mut rng);
             // A segment that ends somewhere along the ray, as towards a light.
             ray.tmax = rng.range(0.3, 1.3) as f32;
-            let a = occluded(&patch, &ray, &full, &mut s_full);
-            let b = occluded(&patch, &ray, &isrt, &mut s_isrt);
+            let a = occluded(&patch, &ray, &full, false, &mut s_full);
+            let b = occluded(&patch, &ray, &isrt, false, &mut s_isrt);
             if a != b {
                 // Only a root within f32 precision of the segment's end may differ.
                 let h = intersect(
@@ -54,6 +56,7 @@ fn isrt_shadow_answers_match_full_shadow_tests() {
                         ..ray
                     },
                     &full,
+                    false,
                     &mut s_full,
                 )
                 .map(|h| h.t);

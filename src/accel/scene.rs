@@ -45,6 +45,24 @@ impl Precision {
             other @ (Precision::Toth(_) | Precision::Cached(_)) => other,
         }
     }
+
+    /// The path for secondary rays leaving `hit`: [`Precision::for_secondary_rays`], and
+    /// for the LG90 kernels with ISRT (LG90 §6, "improved treatment of secondary rays")
+    /// the surface of origin, on which they apply the triviality tests.
+    pub fn leaving(self, hit: &SceneHit) -> Precision {
+        let origin = hit.primitive;
+        match self.for_secondary_rays() {
+            Precision::Toth(cfg) if cfg.isrt => Precision::Toth(TothConfig {
+                surface_of_origin: origin,
+                ..cfg
+            }),
+            Precision::Cached(mut cfg) if cfg.toth.isrt => {
+                cfg.toth.surface_of_origin = origin;
+                Precision::Cached(cfg)
+            }
+            other => other,
+        }
+    }
 }
 
 /// Work done by one query.
@@ -56,6 +74,9 @@ pub struct QueryStats {
     pub bvh_box_tests: u64,
     /// Grid voxels stepped through (0 with the BVH).
     pub voxels_visited: u64,
+    /// Primitives whose outermost box was tested (LG90 §7.1 "surfaces tested"): the grid's
+    /// tight-box tests, or with the BVH the primitives of the leaves reached.
+    pub surface_tests: u64,
 }
 
 impl QueryStats {
@@ -64,6 +85,7 @@ impl QueryStats {
         self.nodes_visited += o.nodes_visited;
         self.bvh_box_tests += o.bvh_box_tests;
         self.voxels_visited += o.voxels_visited;
+        self.surface_tests += o.surface_tests;
     }
 }
 
@@ -75,6 +97,9 @@ pub struct SceneHit {
     pub object: u32,
     /// Patch number within its object (contract order).
     pub patch: u32,
+    /// The patch's number in the accelerator, `None` for a triangle: secondary rays name
+    /// their surface of origin by it ([`Precision::leaving`]).
+    pub primitive: Option<u32>,
     pub u: f64,
     pub v: f64,
     /// The final box of the subdivision (the hit interval), secondary rays start at its
@@ -390,7 +415,9 @@ impl SceneGeometry {
         // Made at the first leaf: most rays that miss never reach one.
         let mut shear = None;
         let patches = self.prepared.len() as u32;
+        let mut surface_tests = 0;
         let t = bvh.traverse_leaves(ray, |range, tmax| {
+            surface_tests += range.len() as u64;
             if patches > 0 {
                 for &prim in &bvh.prim_indices()[range.clone()] {
                     if prim >= patches {
@@ -422,6 +449,7 @@ impl SceneGeometry {
         });
         stats.nodes_visited += t.nodes_visited;
         stats.bvh_box_tests += t.box_tests;
+        stats.surface_tests += surface_tests;
         best
     }
 
@@ -438,7 +466,9 @@ impl SceneGeometry {
         let patches = self.prepared.len() as u32;
         let kernel = &mut stats.kernel;
         let mut hit = false;
+        let mut surface_tests = 0;
         let t = bvh.traverse_leaves(ray, |range, _| {
+            surface_tests += range.len() as u64;
             hit = bvh.prim_indices()[range.clone()]
                 .iter()
                 .any(|&prim| prim < patches && self.patch_occluded(prim, ray, precision, kernel))
@@ -454,6 +484,7 @@ impl SceneGeometry {
         });
         stats.nodes_visited += t.nodes_visited;
         stats.bvh_box_tests += t.box_tests;
+        stats.surface_tests += surface_tests;
         hit
     }
 
@@ -486,6 +517,7 @@ impl SceneGeometry {
         });
         stats.voxels_visited += g.voxels_visited;
         stats.bvh_box_tests += g.box_tests;
+        stats.surface_tests += g.box_tests;
         best
     }
 
@@ -511,6 +543,7 @@ impl SceneGeometry {
         });
         stats.voxels_visited += g.voxels_visited;
         stats.bvh_box_tests += g.box_tests;
+        stats.surface_tests += g.box_tests;
         hit
     }
 
@@ -524,10 +557,12 @@ impl SceneGeometry {
     ) -> Option<PatchHit> {
         match precision {
             Precision::Toth(cfg) => {
-                toth::intersect(&self.originals[prim as usize], ray, cfg, kernel)
+                let origin = cfg.surface_of_origin == Some(prim);
+                toth::intersect(&self.originals[prim as usize], ray, cfg, origin, kernel)
             }
             Precision::Cached(cfg) => {
-                cached::intersect(&self.originals[prim as usize], ray, cfg, kernel)
+                let origin = cfg.toth.surface_of_origin == Some(prim);
+                cached::intersect(&self.originals[prim as usize], ray, cfg, origin, kernel)
             }
             Precision::F32(cfg) | Precision::F64(cfg) => {
                 subdivision::intersect(&self.prepared[prim as usize], ray, cfg, kernel)
@@ -545,10 +580,12 @@ impl SceneGeometry {
     ) -> bool {
         match precision {
             Precision::Toth(cfg) => {
-                toth::occluded(&self.originals[prim as usize], ray, cfg, kernel)
+                let origin = cfg.surface_of_origin == Some(prim);
+                toth::occluded(&self.originals[prim as usize], ray, cfg, origin, kernel)
             }
             Precision::Cached(cfg) => {
-                cached::occluded(&self.originals[prim as usize], ray, cfg, kernel)
+                let origin = cfg.toth.surface_of_origin == Some(prim);
+                cached::occluded(&self.originals[prim as usize], ray, cfg, origin, kernel)
             }
             Precision::F32(cfg) | Precision::F64(cfg) => {
                 subdivision::occluded(&self.prepared[prim as usize], ray, cfg, kernel)
@@ -563,6 +600,7 @@ impl SceneGeometry {
             t,
             object,
             patch,
+            primitive: Some(prim),
             u,
             v,
             hit_box,
@@ -595,6 +633,7 @@ impl SceneGeometry {
             t: h.t as f64,
             object,
             patch: index,
+            primitive: None,
             u: h.b1 as f64,
             v: h.b2 as f64,
             hit_box: triangle::hit_box(h, a, b, c),

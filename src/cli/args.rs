@@ -255,18 +255,21 @@ pub struct KernelArgs {
     /// (Dammertz §2.7.2).
     #[arg(long, value_name = "ULPS")]
     pub rational_dist: Option<u32>,
-    /// Shadow rays stop at the first safe region, without Newton iteration (Lischinski &
-    /// Gonczarowski §6, the ISRT column). Only with `--kernel toth` or `--kernel cached`.
+    /// Improved treatment of secondary rays (Lischinski & Gonczarowski §6, the ISRT
+    /// column): the three triviality tests on the surface a secondary ray leaves, and
+    /// shadow rays stop at the first safe region, without Newton iteration. Only with
+    /// `--kernel toth` or `--kernel cached`.
     #[arg(long)]
     pub isrt: bool,
     /// Surface-tree cache of `--kernel cached` per worker thread, in MiB (Lischinski &
-    /// Gonczarowski §4.3).
-    #[arg(long, value_name = "MIB", default_value_t = crate::kernel::cached::DEFAULT_CACHE_BYTES >> 20)]
-    pub cache_size: usize,
+    /// Gonczarowski §4.3; default 8). Only with `--kernel cached`.
+    #[arg(long, value_name = "MIB")]
+    pub cache_size: Option<usize>,
     /// Deepest cached level of the surface trees of `--kernel cached`; deeper boxes are
-    /// searched but not kept (Lischinski & Gonczarowski §8).
-    #[arg(long, value_name = "LEVELS", default_value_t = crate::kernel::cached::DEFAULT_MAX_DEPTH)]
-    pub cache_depth: u8,
+    /// searched but not kept (Lischinski & Gonczarowski §8; default 6). Only with
+    /// `--kernel cached`.
+    #[arg(long, value_name = "LEVELS")]
+    pub cache_depth: Option<u8>,
     /// Load the BVH from this file (written by `patchtrace bvh`) instead of building it.
     #[arg(long, value_name = "FILE")]
     pub bvh: Option<PathBuf>,

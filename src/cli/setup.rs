@@ -10,7 +10,7 @@ use crate::accel::scene::{Precision, SceneGeometry};
 use crate::cli::args::{
     AccelChoice, HeuristicChoice, KernelArgs, KernelChoice, PrecisionChoice, TerminationChoice,
 };
-use crate::kernel::cached::CachedConfig;
+use crate::kernel::cached::{CachedConfig, DEFAULT_CACHE_BYTES, DEFAULT_MAX_DEPTH};
 use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig, Termination};
 use crate::kernel::toth::TothConfig;
 use crate::render::camera::CameraRays;
@@ -19,6 +19,17 @@ use crate::scene::{Camera, Scene, load_scene};
 /// The kernel path selected by the flags, or why the flags do not go together; `camera`
 /// sizes the pixels of adaptive termination.
 pub fn precision(args: &KernelArgs, camera: &Camera) -> anyhow::Result<Precision> {
+    if args.kernel != KernelChoice::Cached {
+        for (flag, given) in [
+            ("--cache-size", args.cache_size.is_some()),
+            ("--cache-depth", args.cache_depth.is_some()),
+        ] {
+            anyhow::ensure!(
+                !given,
+                "{flag} sizes the surface-tree cache, which only --kernel cached has; add --kernel cached or drop {flag}"
+            );
+        }
+    }
     if matches!(args.kernel, KernelChoice::Toth | KernelChoice::Cached) {
         anyhow::ensure!(
             args.precision == PrecisionChoice::F32,
@@ -31,8 +42,9 @@ pub fn precision(args: &KernelArgs, camera: &Camera) -> anyhow::Result<Precision
         return Ok(match args.kernel {
             KernelChoice::Cached => Precision::Cached(CachedConfig::new(
                 toth,
-                args.cache_size.saturating_mul(1 << 20),
-                args.cache_depth,
+                args.cache_size
+                    .map_or(DEFAULT_CACHE_BYTES, |mib| mib.saturating_mul(1 << 20)),
+                args.cache_depth.unwrap_or(DEFAULT_MAX_DEPTH),
             )),
             _ => Precision::Toth(toth),
         });

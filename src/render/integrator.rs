@@ -33,19 +33,24 @@ pub struct Integrator<'a> {
 impl Integrator<'_> {
     /// Colour and coverage (alpha 1 on geometry, 0 on the background) of a primary ray.
     pub fn primary(&self, ray: &Ray, tally: &mut RayTally) -> Vec4 {
-        let (color, hit) = self.radiance(ray, RayKind::Primary, 1, tally);
+        let precision = self.settings.precision;
+        let (color, hit) = self.radiance(ray, &precision, RayKind::Primary, 1, tally);
         color.extend(if hit { 1.0 } else { 0.0 })
     }
 
-    /// Radiance along `ray`, which is of the given kind at path depth `depth` (primary = 1),
-    /// and whether it hit anything.
-    fn radiance(&self, ray: &Ray, kind: RayKind, depth: u32, tally: &mut RayTally) -> (Vec3, bool) {
+    /// Radiance along `ray`, traced by `precision` (for secondary rays,
+    /// [`Precision::leaving`] the surface they start on), which is of the given kind at path
+    /// depth `depth` (primary = 1), and whether it hit anything.
+    fn radiance(
+        &self,
+        ray: &Ray,
+        precision: &Precision,
+        kind: RayKind,
+        depth: u32,
+        tally: &mut RayTally,
+    ) -> (Vec3, bool) {
         let mut q = QueryStats::default();
-        let precision = match kind {
-            RayKind::Primary => self.settings.precision,
-            _ => self.settings.precision.for_secondary_rays(),
-        };
-        let hit = self.geometry.intersect(ray, &precision, &mut q);
+        let hit = self.geometry.intersect(ray, precision, &mut q);
         tally.record(kind, &q);
         let Some(hit) = hit else {
             return (self.scene.background, false);
@@ -69,6 +74,7 @@ impl Integrator<'_> {
         let plan = &self.settings.plan;
         let ulps = self.settings.ulps;
         let opaque = 1.0 - m.transmit.min(1.0);
+        let leaving = self.settings.precision.leaving(&hit);
 
         let mut color = self.scene.ambient * m.diffuse * opaque;
         let above = secondary_origin(&hit.leave_box, n_out, true, ulps);
@@ -96,9 +102,7 @@ impl Integrator<'_> {
                     tmax,
                 };
                 let mut q = QueryStats::default();
-                let blocked =
-                    self.geometry
-                        .occluded(&shadow, &precision.for_secondary_rays(), &mut q);
+                let blocked = self.geometry.occluded(&shadow, &leaving, &mut q);
                 tally.record(RayKind::Shadow, &q);
                 if blocked {
                     continue;
@@ -120,11 +124,20 @@ impl Integrator<'_> {
         if depth < plan.max_depth {
             if m.reflect > 0.0 && plan.reflection {
                 let r = Ray::new(above, reflect(d, n));
-                color += m.reflect * self.radiance(&r, RayKind::Reflection, depth + 1, tally).0;
+                let kind = RayKind::Reflection;
+                color += m.reflect * self.radiance(&r, &leaving, kind, depth + 1, tally).0;
             }
             if m.transmit > 0.0 && plan.refraction {
-                let through =
-                    self.transmitted(d, n, n_out, outside, m.ior, &hit.leave_box, depth, tally);
+                let through = self.transmitted(
+                    d,
+                    n,
+                    n_out,
+                    outside,
+                    m.ior,
+                    (&hit.leave_box, &leaving),
+                    depth,
+                    tally,
+                );
                 color += m.transmit * through;
             }
         }
@@ -133,7 +146,8 @@ impl Integrator<'_> {
 
     /// Light through a transmissive surface: refraction weighted by 1 − Fresnel, plus the
     /// Fresnel reflection; all reflection under total internal reflection. `n` is the
-    /// shading normal and `n_out` the geometric one, both on the incoming side.
+    /// shading normal and `n_out` the geometric one, both on the incoming side; the rays
+    /// leave `leave_box` and are traced by `leaving`.
     #[allow(clippy::too_many_arguments)]
     fn transmitted(
         &self,
@@ -142,7 +156,7 @@ impl Integrator<'_> {
         n_out: Vec3,
         entering: bool,
         ior: f32,
-        leave_box: &crate::geom::Aabb,
+        (leave_box, leaving): (&crate::geom::Aabb, &Precision),
         depth: u32,
         tally: &mut RayTally,
     ) -> Vec3 {
@@ -156,7 +170,7 @@ impl Integrator<'_> {
         );
         if k < 0.0 {
             return self
-                .radiance(&reflected, RayKind::Reflection, depth + 1, tally)
+                .radiance(&reflected, leaving, RayKind::Reflection, depth + 1, tally)
                 .0;
         }
         let t_dir = eta * d + (eta * cos_i - k.sqrt()) * n;
@@ -165,10 +179,10 @@ impl Integrator<'_> {
         let f = schlick(cos, ior);
         let refracted = Ray::new(secondary_origin(leave_box, n_out, false, ulps), t_dir);
         let through = self
-            .radiance(&refracted, RayKind::Refraction, depth + 1, tally)
+            .radiance(&refracted, leaving, RayKind::Refraction, depth + 1, tally)
             .0;
         let mirror = self
-            .radiance(&reflected, RayKind::Reflection, depth + 1, tally)
+            .radiance(&reflected, leaving, RayKind::Reflection, depth + 1, tally)
             .0;
         (1.0 - f) * through + f * mirror
     }

@@ -69,6 +69,7 @@ impl Tally {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct RayTally {
     counts: [u64; 4],
+    surface_tests: Tally,
     patch_tests: Tally,
     splits: Tally,
     box_tests: Tally,
@@ -81,6 +82,7 @@ pub struct RayTally {
 impl RayTally {
     pub fn record(&mut self, kind: RayKind, q: &QueryStats) {
         self.counts[kind as usize] += 1;
+        self.surface_tests.push(q.surface_tests);
         self.patch_tests.push(q.kernel.patch_tests);
         self.splits.push(q.kernel.splits);
         self.box_tests.push(q.kernel.box_tests + q.bvh_box_tests);
@@ -94,6 +96,7 @@ impl RayTally {
         for (a, b) in self.counts.iter_mut().zip(o.counts) {
             *a += b;
         }
+        self.surface_tests.merge(&o.surface_tests);
         self.patch_tests.merge(&o.patch_tests);
         self.splits.merge(&o.splits);
         self.box_tests.merge(&o.box_tests);
@@ -125,6 +128,7 @@ impl RayTally {
             reflection: self.counts[RayKind::Reflection as usize],
             refraction: self.counts[RayKind::Refraction as usize],
             total: n,
+            surfaces_tested_per_ray: self.surface_tests.spread(n),
             patch_tests_per_ray: self.patch_tests.spread(n),
             splits_per_ray: self.splits.spread(n),
             box_tests_per_ray: self.box_tests.spread(n),
@@ -151,6 +155,11 @@ pub struct RayReport {
     pub reflection: u64,
     pub refraction: u64,
     pub total: u64,
+    /// Primitives whose outermost box the accelerator tested (LG90 §7.1 "surfaces tested
+    /// per ray"): the grid's tight-box tests, or the primitives of the BVH leaves reached.
+    pub surfaces_tested_per_ray: Spread,
+    /// Kernel calls: primitives whose box the ray hits (with the grid) or that sit in a
+    /// reached BVH leaf, and triangle packs.
     pub patch_tests_per_ray: Spread,
     pub splits_per_ray: Spread,
     pub box_tests_per_ray: Spread,
@@ -182,6 +191,8 @@ pub struct CacheReport {
 /// LG90 Tables 2–6 rows of the Toth kernel, per ray over all rays.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct TothReport {
+    /// Patches whose search loop ran (LG90 §7.1): every Toth kernel call; for the cached
+    /// kernel only those where the ray hits a leaf of the surface tree.
     pub surfaces_searched_per_ray: f64,
     pub search_iterations_per_ray: f64,
     pub newton_starts_per_ray: f64,
@@ -190,6 +201,9 @@ pub struct TothReport {
     pub isrt_early_outs: u64,
     pub final_boxes: u64,
     pub cut_off_searches: u64,
+    /// Boxes on the surface of origin dropped by LG90's triviality tests 1–3 (§6), per
+    /// ray.
+    pub trivial_per_ray: [f64; 3],
 }
 
 impl TothReport {
@@ -210,6 +224,7 @@ impl TothReport {
             isrt_early_outs: t.early_outs,
             final_boxes: t.final_boxes,
             cut_off_searches: t.cut_off,
+            trivial_per_ray: t.trivial.map(per_ray),
         }
     }
 }

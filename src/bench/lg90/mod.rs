@@ -3,11 +3,11 @@
 //! with the methods TOTH, ISRT, SCAN, ITBUF and PEANO, and each of Tables 2–6 is printed
 //! beside the paper's numbers ([`paper`]), times normalized to TOTH.
 
+pub mod cpu;
 pub mod paper;
 pub mod report;
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use indicatif::ProgressBar;
 
@@ -140,7 +140,9 @@ pub const METHODS: [Method; 5] = [
 
 impl Method {
     /// The kernel path this method runs; a cached method gets a fresh cache (a new
-    /// [`CachedConfig`] empties the workers' caches), so cases do not share trees.
+    /// [`CachedConfig`] empties the workers' caches), so cases do not share trees. The
+    /// cached methods include ISRT's treatment of secondary rays, as the paper's do (their
+    /// Newton starts per ray equal ISRT's in every table).
     pub fn precision(&self) -> Precision {
         let toth = |isrt| {
             Precision::Toth(TothConfig {
@@ -152,7 +154,10 @@ impl Method {
             MethodKernel::Toth => toth(false),
             MethodKernel::Isrt => toth(true),
             MethodKernel::Cached => Precision::Cached(CachedConfig::new(
-                TothConfig::default(),
+                TothConfig {
+                    isrt: true,
+                    ..TothConfig::default()
+                },
                 DEFAULT_CACHE_BYTES,
                 DEFAULT_MAX_DEPTH,
             )),
@@ -183,8 +188,10 @@ pub struct Config {
 pub struct Run {
     pub method: Method,
     pub report: RayReport,
-    /// Render seconds, excluding scene loading and grid building (as in §7.1).
+    /// Render seconds, excluding scene loading and grid building (as in §7.1): CPU
+    /// seconds of all threads when `cpu`, else wall-clock ([`cpu::Stopwatch`]).
     pub seconds: f64,
+    pub cpu: bool,
 }
 
 /// All runs of one case.
@@ -237,13 +244,14 @@ pub fn run(config: &Config, progress: &ProgressBar) -> Result<Vec<CaseResult>, L
                     plan,
                 },
             };
-            let start = Instant::now();
+            let start = cpu::Stopwatch::start();
             let rendered = render_image_in_order(&integrator, method.order, &ProgressBar::hidden());
-            let seconds = start.elapsed().as_secs_f64();
+            let (seconds, cpu) = start.seconds();
             runs.push(Run {
                 method: *method,
                 report: rendered.tally.report(),
                 seconds,
+                cpu,
             });
             progress.inc(1);
         }

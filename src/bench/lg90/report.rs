@@ -18,6 +18,8 @@ pub enum Statistic {
     SafeRegionWidth,
     CacheMissesPerSurface,
     CacheHitRatio,
+    /// LG90's triviality tests (§6), tests 1–3: not in the paper's tables.
+    Trivial(usize),
     TotalRays,
 }
 
@@ -35,7 +37,7 @@ impl Statistic {
     ];
 
     /// Every row of the report, in order.
-    pub const ALL: [Statistic; 11] = [
+    pub const ALL: [Statistic; 14] = [
         Statistic::NormalizedTime,
         Statistic::SurfacesTested,
         Statistic::SurfacesSearched,
@@ -46,6 +48,9 @@ impl Statistic {
         Statistic::SafeRegionWidth,
         Statistic::CacheMissesPerSurface,
         Statistic::CacheHitRatio,
+        Statistic::Trivial(0),
+        Statistic::Trivial(1),
+        Statistic::Trivial(2),
         Statistic::TotalRays,
     ];
 
@@ -62,6 +67,9 @@ impl Statistic {
             Statistic::SafeRegionWidth => "av. width of safe regions",
             Statistic::CacheMissesPerSurface => "cache misses / surface",
             Statistic::CacheHitRatio => "cache hit ratio",
+            Statistic::Trivial(0) => "triviality test 1 (box) / ray",
+            Statistic::Trivial(1) => "triviality test 2 (K) / ray",
+            Statistic::Trivial(_) => "triviality test 3 (safe region) / ray",
             Statistic::TotalRays => "total num. of rays",
         }
     }
@@ -84,7 +92,7 @@ pub fn ours(stat: Statistic, run: &Run, patches: usize, toth_seconds: Option<f64
     let t = |f: fn(&crate::render::stats::TothReport) -> f64| Some(toth.map_or(0.0, f));
     match stat {
         Statistic::NormalizedTime => toth_seconds.map(|s| run.seconds / s),
-        Statistic::SurfacesTested => Some(r.patch_tests_per_ray.mean),
+        Statistic::SurfacesTested => Some(r.surfaces_tested_per_ray.mean),
         Statistic::SurfacesSearched => t(|x| x.surfaces_searched_per_ray),
         Statistic::RayBoxTests => Some(r.box_tests_per_ray.mean),
         Statistic::SearchIterations => t(|x| x.search_iterations_per_ray),
@@ -97,6 +105,7 @@ pub fn ours(stat: Statistic, run: &Run, patches: usize, toth_seconds: Option<f64
             .map(|c| c.misses as f64 / patches.max(1) as f64),
         // The paper prints percent.
         Statistic::CacheHitRatio => r.cache.as_ref().map(|c| 100.0 * c.hit_ratio),
+        Statistic::Trivial(k) => toth.map(|x| x.trivial_per_ray[k]),
         Statistic::TotalRays => Some(r.total as f64),
     }
 }
@@ -177,8 +186,14 @@ pub fn markdown(results: &[CaseResult]) -> String {
             }
             s.push('\n');
         }
-        s.push_str(
-            "\nPer-ray rows are over all rays (the paper counts some only over rays that meet the scene's box or a surface); the paper's total rays are at 512².\n\n",
+        let clock = if result.runs.iter().all(|r| r.cpu) {
+            "CPU time of all threads"
+        } else {
+            "wall-clock time"
+        };
+        let _ = write!(
+            s,
+            "\nTimes are {clock}. Per-ray rows are over all rays (the paper counts some only over rays that meet the scene's box or a surface); the paper's total rays are at 512².\n\n",
         );
     }
     s

@@ -97,25 +97,27 @@ thread_local! {
 }
 
 /// Nearest hit with `t` in `[ray.tmin, ray.tmax]`, as [`crate::kernel::toth::intersect`]
-/// reports it.
+/// reports it; `origin` when `ray` leaves this patch (LG90 §6's triviality tests apply).
 pub fn intersect(
     patch: &BezierPatch,
     ray: &Ray,
     cfg: &CachedConfig,
+    origin: bool,
     stats: &mut KernelStats,
 ) -> Option<PatchHit> {
-    run(patch, ray, cfg, Goal::Nearest, stats)
+    run(patch, ray, cfg, Goal::Nearest, origin, stats)
 }
 
 /// True when the patch blocks `ray` in `[tmin, tmax]` (shadow rays; with `cfg.toth.isrt`
-/// the first safe region answers, LG90 §6).
+/// the first safe region answers, LG90 §6); `origin` as for [`intersect`].
 pub fn occluded(
     patch: &BezierPatch,
     ray: &Ray,
     cfg: &CachedConfig,
+    origin: bool,
     stats: &mut KernelStats,
 ) -> bool {
-    run(patch, ray, cfg, Goal::Any, stats).is_some()
+    run(patch, ray, cfg, Goal::Any, origin, stats).is_some()
 }
 
 /// Bytes of surface trees the calling thread caches under `cfg` (0 when it has none).
@@ -134,6 +136,7 @@ fn run(
     ray: &Ray,
     cfg: &CachedConfig,
     goal: Goal,
+    origin: bool,
     stats: &mut KernelStats,
 ) -> Option<PatchHit> {
     stats.patch_tests += 1;
@@ -160,7 +163,7 @@ fn run(
             patch,
             ray,
             cfg,
-            goal,
+            (goal, origin),
             &mut tree,
             &mut w.scratch,
             (&mut stats.toth, &mut stats.cached),

@@ -39,29 +39,35 @@ impl Scratch {
 }
 
 /// Searches `patch` for the nearest hit (or any, with `Goal::Any`) starting from the
-/// leaves of `tree` that the ray hits, growing the tree where boxes stay undecided.
+/// leaves of `tree` that the ray hits, growing the tree where boxes stay undecided;
+/// `origin` when the ray leaves this patch (LG90 §6's triviality tests apply).
 pub fn search(
     patch: &BezierPatch,
     ray: &Ray,
     cfg: &CachedConfig,
-    goal: Goal,
+    (goal, origin): (Goal, bool),
     tree: &mut SurfaceTree,
     s: &mut Scratch,
     (toth, cache): (&mut TothStats, &mut CachedStats),
 ) -> Option<PatchHit> {
     let inv = ray.dir.recip();
-    let hits_box = |t: &SurfaceTree, i: u32, tmax: f64, c: &mut CachedStats| {
+    let hits_box = |t: &SurfaceTree, i: u32, tmax: f64, c: &mut CachedStats, trivial: &mut u64| {
         c.tree_box_tests += 1;
-        let n = t.node(i);
-        n.bounds
-            .intersect(ray.origin, inv, ray.tmin, tmax as f32)
-            .map(|(t0, _)| t0 as f64)
+        let b = t.node(i).bounds;
+        let hit = b.intersect(ray.origin, inv, ray.tmin, tmax as f32);
+        // Triviality test 1 (LG90 §6) on the surface of origin: the box lies across the
+        // ray wholly before its start. Counted by a second test, on that surface only.
+        if hit.is_none() && origin {
+            let before = b.intersect(ray.origin, inv, f32::NEG_INFINITY, tmax as f32);
+            *trivial += before.is_some() as u64;
+        }
+        hit.map(|(t0, _)| t0 as f64)
     };
     s.candidates.clear();
     s.stack.clear();
     s.stack.push(0);
     while let Some(i) = s.stack.pop() {
-        let Some(t_lo) = hits_box(tree, i, ray.tmax as f64, cache) else {
+        let Some(t_lo) = hits_box(tree, i, ray.tmax as f64, cache, &mut toth.trivial[0]) else {
             continue;
         };
         let n = tree.node(i);
@@ -79,7 +85,7 @@ pub fn search(
         return None;
     }
     toth.searches += 1;
-    let pr = PatchRay::new(patch, ray, &cfg.toth, &mut s.nets);
+    let pr = PatchRay::new(patch, ray, &cfg.toth, origin, &mut s.nets);
     let mut tmax = ray.tmax as f64;
     let mut best: Option<PatchHit> = None;
     let start = toth.search_iterations;
@@ -112,7 +118,8 @@ pub fn search(
                             if q.intersect(&region).is_none() {
                                 continue;
                             }
-                            if let Some(t_lo) = hits_box(tree, i, tmax, cache) {
+                            let trivial = &mut toth.trivial[0];
+                            if let Some(t_lo) = hits_box(tree, i, tmax, cache, trivial) {
                                 s.candidates.push(Candidate {
                                     t_lo,
                                     region: q,

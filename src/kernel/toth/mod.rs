@@ -45,12 +45,18 @@ pub const DEFAULT_FINAL_ULPS: u32 = crate::kernel::subdivision::DEFAULT_END_ULPS
 /// Settings of the Toth kernel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TothConfig {
-    /// Shadow rays stop at the first safe region (LG90 §6, ISRT).
+    /// LG90 §6's improved treatment of secondary rays (ISRT): shadow rays stop at the
+    /// first safe region, and secondary rays get the triviality tests on their surface of
+    /// origin ([`crate::accel::scene::Precision::leaving`]).
     pub isrt: bool,
     /// Search iterations per ray–patch test.
     pub max_iterations: u32,
     /// End-game size in ulps (see [`DEFAULT_FINAL_ULPS`]).
     pub final_ulps: u32,
+    /// The accelerator's number of the patch the ray leaves, for secondary rays: the
+    /// kernels apply LG90's triviality tests (§6) on that patch. Set per ray by
+    /// [`crate::accel::scene::Precision::leaving`].
+    pub surface_of_origin: Option<u32>,
 }
 
 impl Default for TothConfig {
@@ -59,6 +65,7 @@ impl Default for TothConfig {
             isrt: false,
             max_iterations: DEFAULT_MAX_ITERATIONS,
             final_ulps: DEFAULT_FINAL_ULPS,
+            surface_of_origin: None,
         }
     }
 }
@@ -70,19 +77,28 @@ thread_local! {
 /// Nearest hit with `t` in `[ray.tmin, ray.tmax]`. `t` is the ray parameter of the
 /// converged Newton point; `hit_box` is the outward-rounded `f32` box of the patch over a
 /// parameter box that holds the root (the contraction's error bound around the Newton
-/// point), so secondary rays can start from its corners.
+/// point), so secondary rays can start from its corners. `origin` when `ray` is a
+/// secondary ray leaving this patch (LG90 §6's triviality tests apply).
 pub fn intersect(
     patch: &BezierPatch,
     ray: &Ray,
     cfg: &TothConfig,
+    origin: bool,
     stats: &mut KernelStats,
 ) -> Option<PatchHit> {
-    run(patch, ray, cfg, Goal::Nearest, stats)
+    run(patch, ray, cfg, Goal::Nearest, origin, stats)
 }
 
-/// True when the patch blocks `ray` in `[tmin, tmax]` (shadow rays).
-pub fn occluded(patch: &BezierPatch, ray: &Ray, cfg: &TothConfig, stats: &mut KernelStats) -> bool {
-    run(patch, ray, cfg, Goal::Any, stats).is_some()
+/// True when the patch blocks `ray` in `[tmin, tmax]` (shadow rays); `origin` as for
+/// [`intersect`].
+pub fn occluded(
+    patch: &BezierPatch,
+    ray: &Ray,
+    cfg: &TothConfig,
+    origin: bool,
+    stats: &mut KernelStats,
+) -> bool {
+    run(patch, ray, cfg, Goal::Any, origin, stats).is_some()
 }
 
 fn run(
@@ -90,12 +106,13 @@ fn run(
     ray: &Ray,
     cfg: &TothConfig,
     goal: Goal,
+    origin: bool,
     stats: &mut KernelStats,
 ) -> Option<PatchHit> {
     stats.patch_tests += 1;
     let before = stats.toth.box_tests;
-    let hit =
-        SCRATCH.with_borrow_mut(|s| search::search(patch, ray, cfg, goal, s, &mut stats.toth));
+    let hit = SCRATCH
+        .with_borrow_mut(|s| search::search(patch, ray, cfg, goal, s, origin, &mut stats.toth));
     // The kernel's ray–box tests are counted with every other kernel's too.
     stats.box_tests += stats.toth.box_tests - before;
     hit

@@ -2,10 +2,16 @@
 //! matrix `Y` stays the inverse Jacobian at the safe region's midpoint, so the iteration
 //! converges linearly with the rate `r` Krawczyk's test proved, and the a-posteriori bound
 //! `|x_k − x*| ≤ r / (1 − r) · |x_k − x_{k−1}|` of a contraction bounds the error.
+//!
+//! The same bound gives LG90's third triviality test (§6) for rays leaving the surface:
+//! with a bound on the ray parameter's derivatives over the safe region, each iterate
+//! encloses the root's `t`, and once that enclosure ends before `tmin` the root is the
+//! trivial one and the iteration stops ([`Trivial`]).
 
-use crate::geom::interval::{Interval, IntervalNet, ParamBox};
+use crate::geom::interval::{IPoint, Interval, IntervalNet, ParamBox};
 
 use super::krawczyk::{Mat2, newton_step};
+use super::raynet::{TAU, W};
 
 /// Newton stops when a step moves (u, v) by less than this: one ulp of `f32` in the upper
 /// half `[0.5, 1)` of the parameter domain (2⁻²⁴). The kernel reports (u, v) in `f32`, so
@@ -31,23 +37,67 @@ pub struct NewtonResult {
     pub iterations: u32,
 }
 
+/// LG90's third triviality test (§6) for one safe region: the root is trivial when its ray
+/// parameter is proved below `tmin`. `du`, `dv` enclose the partial derivatives of the
+/// projected net over a convex box holding the root and every iterate after the first
+/// (`K` or the safe region; `IntervalNet::derivative_hulls`), so along the segment from an
+/// iterate to the root `τ` and `w` change by at most their magnitude times the distance.
+#[derive(Clone, Copy, Debug)]
+pub struct Trivial {
+    pub tmin: f64,
+    pub du: IPoint,
+    pub dv: IPoint,
+}
+
+impl Trivial {
+    /// True when every point within `radius` (max-norm, inside the region) of the point
+    /// whose projected value is `g` has ray parameter `τ / w < tmin`.
+    fn proves(&self, g: &IPoint, radius: f64) -> bool {
+        let spread = |c: usize| {
+            let r = ((self.du[c].mag() + self.dv[c].mag()) * radius).next_up();
+            Interval::spanning(-r, r)
+        };
+        let t = (g[TAU] + spread(TAU)).checked_div(g[W] + spread(W));
+        t.is_some_and(|t| t.hi() < self.tmin)
+    }
+}
+
+/// How simple Newton ended.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Newton {
+    /// Converged (the step fell below [`NEWTON_STEP_LIMIT`] or the iteration bound ran out).
+    Converged(NewtonResult),
+    /// The [`Trivial`] test proved the root's `t` below `tmin` after `iterations` steps.
+    Trivial { iterations: u32 },
+    /// A step was not finite (a singular or overflowing evaluation).
+    Failed,
+}
+
 /// Simple Newton from the midpoint of `start` (a safe region with root inside `region`
-/// and contraction rate `contraction`) on the equations of the projected `net`.
+/// and contraction rate `contraction`) on the equations of the projected `net`; with
+/// `trivial`, stops as soon as that test proves the root lies before the ray's start.
 pub fn simple_newton(
     net: &IntervalNet,
     start: &ParamBox,
     region: &ParamBox,
     contraction: f64,
     inverse: &Mat2,
-) -> Option<NewtonResult> {
+    trivial: Option<&Trivial>,
+) -> Newton {
     let (mut u, mut v) = start.mid();
     let mut last = f64::INFINITY;
     let mut iterations = 0;
+    let bound = |step: f64| ERROR_BOUND_SAFETY * contraction / (1.0 - contraction) * step;
     while iterations < NEWTON_MAX_ITERATIONS {
         let (g, _, _) = net.eval(u, v);
+        if let Some(test) = trivial.filter(|_| last.is_finite()) {
+            if test.proves(&g, bound(last)) {
+                return Newton::Trivial { iterations };
+            }
+        }
         let [du, dv] = newton_step(inverse, &g);
         if !(du.is_finite() && dv.is_finite()) {
-            return None;
+            return Newton::Failed;
         }
         // The iteration maps the safe region into K, so clamping to K only removes
         // rounding overshoot.
@@ -59,13 +109,13 @@ pub fn simple_newton(
             break;
         }
     }
-    let radius = ERROR_BOUND_SAFETY * contraction / (1.0 - contraction) * last;
+    let radius = bound(last);
     let around = |x: f64, side: Interval| {
         Interval::new((x - radius).next_down(), (x + radius).next_up())
             .and_then(|b| b.intersect(side))
             .unwrap_or(side)
     };
-    Some(NewtonResult {
+    Newton::Converged(NewtonResult {
         u,
         v,
         enclosure: ParamBox {
@@ -74,4 +124,72 @@ pub fn simple_newton(
         },
         iterations,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{BezierPatch, Ray};
+    use crate::kernel::toth::krawczyk::{Classification, classify};
+    use crate::kernel::toth::raynet::RayFrame;
+    use glam::{DVec3, Vec3};
+
+    /// Simple Newton with the triviality test 3 on a bilinear plane patch hit at a known
+    /// ray parameter: `tmin` just after the root proves it trivial, `tmin` just before it
+    /// lets Newton converge to it. Returns both outcomes and the closed-form `t`.
+    fn newton_around_root(margin: f64) -> (Newton, Newton, f64) {
+        let p = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(2.0, 0.0, 0.5),
+            DVec3::new(0.0, 2.0, 0.0),
+            DVec3::new(2.0, 2.0, 0.5),
+        ];
+        let patch = BezierPatch::from_points(1, 1, &p).unwrap();
+        let o = Vec3::new(0.7, 0.9, 3.0);
+        let ray = Ray::new(o, Vec3::new(0.1, 0.2, -1.0));
+        // The plane z = x / 4: o.z + t d.z = (o.x + t d.x) / 4.
+        let (ox, oz, dx, dz) = (0.7f64, 3.0f64, 0.1f32 as f64, -1.0f64);
+        let t = (ox / 4.0 - oz) / (dz - dx / 4.0);
+        let mut net = IntervalNet::default();
+        RayFrame::new(&ray).project(patch.homogeneous_points(), 2, 2, &mut net);
+        let x = ParamBox::UNIT;
+        let mut sub = IntervalNet::default();
+        net.subnet_into(&x, &mut sub);
+        let Classification::Safe {
+            region,
+            contraction,
+            inverse,
+        } = classify(&net, &sub, &x)
+        else {
+            panic!("a plane is a safe region");
+        };
+        let (du, dv) = sub.derivative_hulls(&x).unwrap();
+        let run = |tmin: f64| {
+            let test = Trivial { tmin, du, dv };
+            simple_newton(&net, &x, &region, contraction, &inverse, Some(&test))
+        };
+        (run(t + margin), run(t - margin), t)
+    }
+
+    /// How far from the root `tmin` is put: far above the `f32` rounding of the ray
+    /// (≈ 1e-7 relative on t ≈ 3) and the f64 evaluation, far below the plane's size.
+    const MARGIN: f64 = 1e-4;
+
+    #[test]
+    fn test_3_proves_a_root_before_tmin_trivial() {
+        let (fires, _, _) = newton_around_root(MARGIN);
+        assert!(matches!(fires, Newton::Trivial { .. }), "{fires:?}");
+    }
+
+    #[test]
+    fn test_3_lets_newton_converge_to_a_root_after_tmin() {
+        let (_, converges, t) = newton_around_root(MARGIN);
+        let Newton::Converged(n) = converges else {
+            panic!("{converges:?}");
+        };
+        // The converged point is on the plane at the closed-form parameter.
+        let (ox, dx) = (0.7, 0.1f32 as f64);
+        let u = (ox + t * dx) / 2.0;
+        assert!((n.u - u).abs() < MARGIN, "u {} vs {u}", n.u);
+    }
 }

@@ -7,6 +7,15 @@
 //! small for analysis", Krawczyk's test, simple Newton in a safe region, ISRT) are
 //! [`examine`]; only what happens to an undecided box differs between this kernel and the
 //! cached quadtree kernel ([`crate::kernel::cached`]), which calls [`examine`] too.
+//!
+//! On the surface a secondary ray leaves, [`examine`] adds LG90's three "triviality tests"
+//! (§6), which drop boxes holding only the trivial intersection before it is computed. Our
+//! secondary rays start off the hit box (Dammertz §2.4), so the trivial root lies before
+//! `tmin` and the paper's `δ` is `tmin`: (1) the box's ray parameters end before `tmin`;
+//! (2) the ray parameters of the sub-patch over Krawczyk's `K` end before `tmin`; (3) in a
+//! safe region, simple Newton's error bound proves the unique root's `t` below `tmin`
+//! ([`super::newton::Trivial`]). Each only drops boxes whose roots all lie before `tmin`,
+//! so the answer is the full search's; on other patches the extra bounds rarely pay.
 
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -18,7 +27,7 @@ use crate::kernel::PatchHit;
 
 use super::TothConfig;
 use super::krawczyk::{Classification, classify, invert, newton_step};
-use super::newton::simple_newton;
+use super::newton::{Newton, Trivial, simple_newton};
 use super::raynet::{G1, G2, RayBox, RayFrame};
 use super::stats::TothStats;
 
@@ -76,17 +85,25 @@ pub enum Goal {
 }
 
 /// One ray against one patch: the ray's frame (the patch is projected into it, in
-/// [`Nets`]), the end-game size and the ray's start.
+/// [`Nets`]), the end-game size, the ray's start, and whether the ray leaves this patch.
 pub struct PatchRay<'a> {
     patch: &'a BezierPatch,
     frame: RayFrame,
     final_extent: f64,
     tmin: f64,
+    origin: bool,
 }
 
 impl<'a> PatchRay<'a> {
-    /// Projects `patch` into the frame of `ray` (into `nets`).
-    pub fn new(patch: &'a BezierPatch, ray: &Ray, cfg: &TothConfig, nets: &mut Nets) -> Self {
+    /// Projects `patch` into the frame of `ray` (into `nets`); `origin` when the ray is a
+    /// secondary ray leaving this patch (the triviality tests apply, LG90 §6).
+    pub fn new(
+        patch: &'a BezierPatch,
+        ray: &Ray,
+        cfg: &TothConfig,
+        origin: bool,
+        nets: &mut Nets,
+    ) -> Self {
         let frame = RayFrame::new(ray);
         let (nu, nv) = (patch.degree_u() + 1, patch.degree_v() + 1);
         frame.project(patch.homogeneous_points(), nu, nv, &mut nets.projected);
@@ -97,6 +114,7 @@ impl<'a> PatchRay<'a> {
             frame,
             final_extent: cfg.final_ulps as f64 * ulp_of(scale as f32),
             tmin: ray.tmin as f64,
+            origin,
         }
     }
 }
@@ -116,8 +134,9 @@ pub enum Step {
 
 /// LG90 §4.2 steps 3–7 on the box `x`: the ray–box test in ray coordinates, the box too
 /// small for analysis (step 4), Krawczyk's test (5–6), and simple Newton in a safe region
-/// (7), or with `Goal::Any` and `cfg.isrt` the safe region alone (§6). Counts a search
-/// iteration when the ray meets the box.
+/// (7), or with `Goal::Any` and `cfg.isrt` the safe region alone (§6), with the
+/// triviality tests of §6 on the surface of origin. Counts a search iteration when the ray
+/// meets the box.
 pub fn examine(
     pr: &PatchRay,
     nets: &mut Nets,
@@ -137,13 +156,44 @@ pub fn examine(
     let rb = pr.frame.ray_box(sub);
     stats.box_tests += 1;
     if !rb.is_hit(pr.tmin, tmax) {
+        // Triviality test 1 is the ray–box test's own `t < tmin` bound; counted where it
+        // alone decides on the surface of origin.
+        let across = rb.g1.contains(0.0) && rb.g2.contains(0.0);
+        if pr.origin && across && rb.t.hi() < pr.tmin {
+            stats.trivial[0] += 1;
+        }
         return Step::Miss;
     }
     stats.search_iterations += 1;
     if pr.frame.extent(&rb) <= pr.final_extent {
         return final_box(pr, nets, x, &rb, stats).map_or(Step::Miss, Step::Hit);
     }
-    match classify(projected, sub, x) {
+    let class = classify(projected, sub, x);
+    // The sub-patch over K in ray coordinates, for triviality test 2 and ISRT; `sub` is
+    // then the sub-net over K, whose derivative bounds test 3 uses. The triviality tests
+    // only run where the box reaches back before `tmin` (nothing else can be trivial), and
+    // test 2 only on safe regions: on undecided boxes its extra sub-net cost more than it
+    // saved, since the halves of a box it would drop fail the ray–box test next anyway
+    // (measured on the half-pipe of tests/lg6_trivial.rs: 224 sub-nets, 5 boxes dropped,
+    // no search iteration saved).
+    let isrt = goal == Goal::Any && cfg.isrt;
+    let trivial_here = pr.origin && rb.t.lo() < pr.tmin;
+    let k_box = match class {
+        Classification::Safe { region, .. } if (trivial_here || isrt) && region != *x => {
+            Some(region)
+        }
+        _ => None,
+    }
+    .map(|region| {
+        projected.subnet_into(&region, sub);
+        stats.box_tests += 1;
+        pr.frame.ray_box(sub)
+    });
+    if trivial_here && k_box.is_some_and(|kb| kb.t.hi() < pr.tmin) {
+        stats.trivial[1] += 1;
+        return Step::Miss;
+    }
+    match class {
         Classification::Excluded => {
             stats.excluded += 1;
             Step::Miss
@@ -157,12 +207,10 @@ pub fn examine(
             contraction,
             inverse,
         } => {
-            if goal == Goal::Any && cfg.isrt {
+            let kb = k_box.unwrap_or(rb);
+            if isrt {
                 // ISRT: the safe region proves a root; its ray parameter lies in the
                 // sub-patch's t-range over K.
-                projected.subnet_into(&region, sub);
-                let kb = pr.frame.ray_box(sub);
-                stats.box_tests += 1;
                 if kb.t.lo() >= pr.tmin && kb.t.hi() <= tmax {
                     stats.early_outs += 1;
                     let (u, v) = region.mid();
@@ -177,20 +225,52 @@ pub fn examine(
                     return Step::Miss;
                 }
             }
+            // Triviality test 3 where the root may lie on either side of `tmin`; `sub` is
+            // the sub-net over K (or over the box when K is the box).
+            let over = if k_box.is_some() { region } else { *x };
+            let trivial = (trivial_here && kb.t.lo() < pr.tmin)
+                .then(|| sub.derivative_hulls(&over))
+                .flatten()
+                .map(|(du, dv)| Trivial {
+                    tmin: pr.tmin,
+                    du,
+                    dv,
+                });
             stats.newton_starts += 1;
             stats.safe_width_sum += x.width();
-            simple_newton(projected, x, &region, contraction, &inverse)
-                .and_then(|n| {
+            match simple_newton(
+                projected,
+                x,
+                &region,
+                contraction,
+                &inverse,
+                trivial.as_ref(),
+            ) {
+                Newton::Converged(n) => {
                     stats.newton_iterations += n.iterations as u64;
-                    let t = ray_parameter(projected, n.u, n.v)?;
-                    (t >= pr.tmin && t <= tmax).then(|| PatchHit {
-                        t: t as f32,
-                        u: n.u as f32,
-                        v: n.v as f32,
-                        hit_box: enclosure_box(pr.patch, &n.enclosure, homogeneous, euclid_sub),
-                    })
-                })
-                .map_or(Step::Miss, Step::Hit)
+                    ray_parameter(projected, n.u, n.v)
+                        .filter(|&t| t >= pr.tmin && t <= tmax)
+                        .map_or(Step::Miss, |t| {
+                            Step::Hit(PatchHit {
+                                t: t as f32,
+                                u: n.u as f32,
+                                v: n.v as f32,
+                                hit_box: enclosure_box(
+                                    pr.patch,
+                                    &n.enclosure,
+                                    homogeneous,
+                                    euclid_sub,
+                                ),
+                            })
+                        })
+                }
+                Newton::Trivial { iterations } => {
+                    stats.newton_iterations += iterations as u64;
+                    stats.trivial[2] += 1;
+                    Step::Miss
+                }
+                Newton::Failed => Step::Miss,
+            }
         }
     }
 }
@@ -204,10 +284,11 @@ pub fn search(
     cfg: &TothConfig,
     goal: Goal,
     s: &mut Scratch,
+    origin: bool,
     stats: &mut TothStats,
 ) -> Option<PatchHit> {
     stats.searches += 1;
-    let pr = PatchRay::new(patch, ray, cfg, &mut s.nets);
+    let pr = PatchRay::new(patch, ray, cfg, origin, &mut s.nets);
     let mut tmax = ray.tmax as f64;
     let mut best: Option<PatchHit> = None;
     s.candidates.clear();

@@ -29,6 +29,10 @@ pub struct TothStats {
     pub final_boxes: u64,
     /// Searches cut off by the iteration bound.
     pub cut_off: u64,
+    /// Boxes of the surface a secondary ray leaves dropped by each of LG90's three
+    /// triviality tests (§6): the box's, `K`'s, and the safe region's root's ray parameter
+    /// proved below `tmin`.
+    pub trivial: [u64; 3],
 }
 
 impl TothStats {
@@ -44,6 +48,9 @@ impl TothStats {
         self.early_outs += o.early_outs;
         self.final_boxes += o.final_boxes;
         self.cut_off += o.cut_off;
+        for (a, b) in self.trivial.iter_mut().zip(o.trivial) {
+            *a += b;
+        }
     }
 
     /// Mean simple Newton iterations per start.

@@ -1,0 +1,52 @@
+//! `--cache-size` and `--cache-depth` size the surface-tree cache of `--kernel cached`;
+//! with any other kernel they would be silently ignored, so they are an error there.
+
+mod common;
+
+use common::{render, run, stderr, testdata};
+
+/// Every kernel without a surface-tree cache rejects each cache flag, in `render` and
+/// `trace`, naming the flag and the kernel that takes it, and writes no image.
+#[test]
+fn cache_flags_need_the_cached_kernel() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.png");
+    let scene = testdata("distorted_patch.ron");
+    let rays = testdata("camera_probe.rays");
+    for kernel in ["subdivision", "toth"] {
+        for flag in [["--cache-size", "4"], ["--cache-depth", "3"]] {
+            let extra = ["--kernel", kernel, flag[0], flag[1]];
+            let r = render(&scene, &out, (8, 8), &extra);
+            let mut trace_args = vec!["trace", scene.to_str().unwrap()];
+            trace_args.extend_from_slice(&["--rays", rays.to_str().unwrap()]);
+            trace_args.extend_from_slice(&extra);
+            let t = run(&trace_args);
+            for (cmd, o) in [("render", r), ("trace", t)] {
+                let err = stderr(&o);
+                assert!(!o.status.success(), "{cmd} {extra:?} succeeded");
+                assert!(!err.contains("panicked"), "{err}");
+                assert!(err.contains(flag[0]), "{cmd} {extra:?}: {err}");
+                assert!(err.contains("--kernel cached"), "{cmd} {extra:?}: {err}");
+            }
+            assert!(!out.exists(), "render {extra:?} wrote an image");
+        }
+    }
+}
+
+/// The same flags with `--kernel cached` render.
+#[test]
+fn cache_flags_work_with_the_cached_kernel() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.png");
+    let extra = [
+        "--kernel",
+        "cached",
+        "--cache-size",
+        "1",
+        "--cache-depth",
+        "3",
+    ];
+    let o = render(&testdata("distorted_patch.ron"), &out, (8, 8), &extra);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.exists());
+}
