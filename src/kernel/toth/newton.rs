@@ -90,10 +90,10 @@ pub fn simple_newton(
     let bound = |step: f64| ERROR_BOUND_SAFETY * contraction / (1.0 - contraction) * step;
     while iterations < NEWTON_MAX_ITERATIONS {
         let (g, _, _) = net.eval(u, v);
-        if let Some(test) = trivial.filter(|_| last.is_finite()) {
-            if test.proves(&g, bound(last)) {
-                return Newton::Trivial { iterations };
-            }
+        if let Some(test) = trivial.filter(|_| last.is_finite())
+            && test.proves(&g, bound(last))
+        {
+            return Newton::Trivial { iterations };
         }
         let [du, dv] = newton_step(inverse, &g);
         if !(du.is_finite() && dv.is_finite()) {
