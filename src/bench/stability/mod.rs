@@ -19,10 +19,11 @@ pub use run::{BOX_TOLERANCE_ULPS, Figures, KernelPath, SplitFigures, run_case};
 /// (issue 7, "done when").
 pub const MAX_MEDIAN_ULPS: f64 = 4.0;
 
-/// Largest number of de Casteljau splits one ray–patch test may take. The kernel's search
-/// is at most `2 · 32` splits deep in `f32` (src/kernel/subdivision/param.rs); the search
-/// visits more than one path only where several sub-boxes overlap the ray.
-pub const MAX_SPLITS_PER_PATCH_TEST: u64 = 4096;
+/// Largest number of de Casteljau splits one ray–patch test may take: the kernel's proven
+/// bound (src/kernel/subdivision/search.rs), 4096 at full precision and 24 doublings of a
+/// coarsening end game 64 splits apart. Without that budget the work has no bound: a
+/// grazing ray hits about 1/θ boxes per level (BENCHMARKS.md, issue 7).
+pub const MAX_SPLITS_PER_PATCH_TEST: u64 = crate::kernel::subdivision::MAX_SPLITS_PER_TEST;
 
 /// One acceptance criterion of issue 7 for the float-precision kernel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -34,6 +34,42 @@ pub const DEFAULT_RATIONAL_DIST: u32 = 16;
 /// rounding bound the tests allow (tests/kernel_newton.rs).
 pub const DEFAULT_END_ULPS: u32 = 8;
 
+/// Splits a ray–patch test takes at full precision before its end game coarsens
+/// ([`SubdivisionConfig::full_precision_splits`]). A ray that runs at a small angle θ to the
+/// surface over a stretch hits about 1/θ boxes on every level, each of which must be split
+/// before the nearest-first search can reject it (BENCHMARKS.md, issue 7 diagnosis), so
+/// without a budget the work has no bound in θ. A coarsened box is entered where the ray
+/// runs within that box's size above the surface, which on a grazing ray can be far along
+/// it from the crossing, so the budget is set above what ordinary rays need: the teapot's
+/// primary rays take at most 3786 splits per test (`cargo bench --bench kernel`); with
+/// 2560 the few pairs above that coarsened and moved the mean hit error from 13.8 to 27
+/// ulps (max 1.15e6, along a grazing ray). Rational patches converge more slowly (their
+/// boxes come from homogeneous division, §2.7.2): a ray of tests/kernel_newton.rs at a
+/// random rational patch needs 7150 splits, and a budget of 4096 moved its hit 1e-3 off
+/// the crossing. 16384 leaves a factor of two above that; the stability suite's worst
+/// unbudgeted test (15251 splits, a folded patch) stays just below it.
+pub const DEFAULT_FULL_PRECISION_SPLITS: u32 = 16384;
+
+/// After the full-precision budget, the diameter below which a box is final doubles every
+/// this many splits, starting from [`COARSEN_BASE_ULPS`] ulps of the patch scale.
+pub const COARSEN_STEP_SPLITS: u32 = 64;
+
+/// Start of the coarsened end game, in ulps of the root box's largest coordinate
+/// magnitude: the default end game ([`DEFAULT_END_ULPS`]), whatever `end_ulps` is set to.
+pub const COARSEN_BASE_ULPS: u32 = 8;
+
+/// Doublings after which the coarsened end game exceeds every box: the root box's L1
+/// diameter is at most 6 times its largest coordinate magnitude `s` (with outward
+/// rounding, below 8 s), and `COARSEN_BASE_ULPS` ulps of `s` are more than `8 s 2^-24`
+/// (an `f32` ulp of `s` exceeds `s 2^-24`), so 24 doublings reach `8 s`.
+pub const COARSEN_DOUBLINGS: u32 = 24;
+
+/// The most splits one ray–patch test of the default configuration can take: every node
+/// is final once the coarsened end game exceeds every box, so no split follows the last
+/// doubling ([`super::search`]).
+pub const MAX_SPLITS_PER_TEST: u64 =
+    DEFAULT_FULL_PRECISION_SPLITS as u64 + (COARSEN_DOUBLINGS * COARSEN_STEP_SPLITS) as u64;
+
 /// When a box is final, besides the guards every criterion keeps: the box stopped
 /// shrinking (§2.3.3), its L1 diameter fell below the end game ([`DEFAULT_END_ULPS`]), its
 /// parameter cell reached the per-direction limit ([`super::param`]), or, for rational
@@ -89,6 +125,13 @@ pub struct SubdivisionConfig {
     /// ([`SubdivisionConfig::for_secondary_rays`]), whose origins are corners of
     /// world-space hit boxes (Dammertz §2.4).
     pub ray_space: bool,
+    /// The work budget: after this many splits of one ray–patch test the end game doubles
+    /// every [`COARSEN_STEP_SPLITS`] splits, so a test takes at most this plus
+    /// `COARSEN_DOUBLINGS · COARSEN_STEP_SPLITS` splits. A box final only by the budget is
+    /// still a box of the sub-patch hit by the ray, so its hit stays within the box's own
+    /// extent of the surface; only its size grows. `None` (the `f64` reference) never
+    /// coarsens.
+    pub full_precision_splits: Option<u32>,
 }
 
 impl Default for SubdivisionConfig {
@@ -99,6 +142,7 @@ impl Default for SubdivisionConfig {
             rational_dist: DEFAULT_RATIONAL_DIST,
             end_ulps: DEFAULT_END_ULPS,
             ray_space: true,
+            full_precision_splits: Some(DEFAULT_FULL_PRECISION_SPLITS),
         }
     }
 }

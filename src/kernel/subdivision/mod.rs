@@ -37,8 +37,8 @@ use std::cell::RefCell;
 use glam::Vec3;
 
 pub use config::{
-    DEFAULT_END_ULPS, DEFAULT_RATIONAL_DIST, ScreenFootprint, SplitHeuristic, SubdivisionConfig,
-    Termination,
+    DEFAULT_END_ULPS, DEFAULT_RATIONAL_DIST, MAX_SPLITS_PER_TEST, ScreenFootprint, SplitHeuristic,
+    SubdivisionConfig, Termination,
 };
 pub use prepared::PreparedPatch;
 pub use reference::{PatchHit64, intersect_f64};

@@ -45,13 +45,18 @@ pub fn intersect_f64(
     let mut scratch = Scratch::default();
     let mut nets = GeneralStack::new(&mut scratch.nets, &net, shape);
     let mut stats = KernelStats::default();
+    // The reference runs to full precision on every ray, however long it takes.
+    let cfg = SubdivisionConfig {
+        full_precision_splits: None,
+        ..*cfg
+    };
     let h = search(
         &mut nets,
         &mut scratch.nodes,
         root,
         &ray,
         shape.rational,
-        cfg,
+        &cfg,
         false,
         &mut stats,
     )?;

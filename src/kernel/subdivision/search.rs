@@ -7,8 +7,31 @@
 //! storage writes the children where they belong). Whether a child is a final box is
 //! [`Stop::is_final`]: a hit at its entry `t`, which shortens the ray so that farther stack
 //! entries are dropped.
+//!
+//! Two rules keep the work bounded. A ray at a small angle θ to the surface hits about 1/θ
+//! boxes on every level along the stretch where it runs close to the surface, and the
+//! nearest-first search must split each before it can reject it, so the work has no bound
+//! in θ (BENCHMARKS.md, issue 7).
+//! - Once a final box is hit, a pending box entered less than that box's extent (largest
+//!   edge, over the largest direction component) before the hit is dropped: a hit in it
+//!   would lie within the final box's extent of the one found (issue 7 counts hits within
+//!   the final box's own extent as agreeing), and its sub-boxes are entered no earlier,
+//!   since de Casteljau averages stay within the parent's coordinates.
+//! - After [`SubdivisionConfig::full_precision_splits`] splits the end game coarsens: the
+//!   diameter below which a box is final starts at [`COARSEN_BASE_ULPS`] ulps of the
+//!   patch scale and doubles every [`COARSEN_STEP_SPLITS`] splits. After
+//!   [`COARSEN_DOUBLINGS`] doublings it exceeds every box (see there), so every live box
+//!   is final and no split follows: a test takes at most `full_precision_splits +
+//!   COARSEN_DOUBLINGS · COARSEN_STEP_SPLITS` splits ([`super::config::MAX_SPLITS_PER_TEST`]
+//!   for the default). A box final by this rule is still a sub-patch's box hit by the ray,
+//!   so the hit is within its own extent of the surface; rays that exhaust the budget get a
+//!   larger box, never a hole. Until the last doubling a coarsened box must not contain
+//!   the ray's origin (entry `t` above `tmin`): a secondary ray that grazes its surface
+//!   near its origin would otherwise take the coarse box around the origin for a hit.
 
-use super::config::{SubdivisionConfig, Termination};
+use super::config::{
+    COARSEN_BASE_ULPS, COARSEN_DOUBLINGS, COARSEN_STEP_SPLITS, SubdivisionConfig, Termination,
+};
 use super::float::{GBox, GRay, KernelFloat};
 use super::heuristics::{Corners, choose};
 use super::param::{ParamCell, Split};
@@ -83,21 +106,46 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
     let mut best: Option<SearchHit<T>> = None;
     let max = T::MAX_LEVEL;
     let stop = Stop::new(cfg, &root, ray, rational, nets.end_game_floor());
+    let (mut splits, mut doublings) = (0u32, 0u32);
+    // The coarsened end game: boxes with an L1 diameter up to this are final.
+    let mut coarse = -T::INFINITY;
     loop {
-        // A popped entry was tested against an older, longer ray; after a hit only strictly
-        // nearer boxes matter.
+        // A popped entry was tested against an older, longer ray; after a hit only boxes
+        // entered more than the hit box's extent before it matter (`tmax` is that bound).
         let live = cur.t_enter <= tmax && (best.is_none() || cur.t_enter < tmax);
-        if live && cur.is_final {
+        // A coarsened box is final only if the ray starts outside it (so a secondary ray
+        // cannot take the coarse box around its own origin for a hit), until the last
+        // doubling, after which every box is.
+        let coarse_final = doublings > 0
+            && (cur.t_enter > ray.tmin || doublings > COARSEN_DOUBLINGS)
+            && cur.bbox.l1_diameter() <= coarse;
+        if live && (cur.is_final || coarse_final) {
             best = Some(SearchHit {
                 t: cur.t_enter,
                 cell: cur.cell,
                 bbox: cur.bbox,
             });
-            tmax = cur.t_enter;
+            tmax = cur.t_enter - stop.extent_along_ray(&cur.bbox);
             if any_hit {
                 return best;
             }
         } else if live {
+            if let Some(full) = stop.full_precision_splits {
+                // Update j (j = 0 sets the base, then doublings) once `full + j · step`
+                // splits are done; after update j = COARSEN_DOUBLINGS every box is final.
+                if doublings <= COARSEN_DOUBLINGS
+                    && splits >= full.saturating_add(doublings * COARSEN_STEP_SPLITS)
+                {
+                    coarse = if doublings == 0 {
+                        stop.coarse_base
+                    } else {
+                        coarse + coarse
+                    };
+                    doublings += 1;
+                    continue;
+                }
+            }
+            splits += 1;
             let (lu, lv) = cur.cell.levels();
             let dir = if lu >= max {
                 Split::V
@@ -161,15 +209,20 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
 /// The end-game L1 diameter of a search from `root`: `end_ulps` ulps of the largest
 /// coordinate magnitude of the box (see [`Stop`]).
 pub fn end_game_diameter<T: KernelFloat>(root: &GBox<T>, end_ulps: u32) -> T {
-    let scale = (0..3)
+    let scale = root_scale(root);
+    (scale.next_up() - scale) * T::from_f64(end_ulps as f64)
+}
+
+/// The largest coordinate magnitude of `root`, the scale the net rounds to.
+fn root_scale<T: KernelFloat>(root: &GBox<T>) -> T {
+    (0..3)
         .map(|i| {
             root.min[i]
                 .max(-root.min[i])
                 .max(root.max[i])
                 .max(-root.max[i])
         })
-        .fold(T::ZERO, |a, b| a.max(b));
-    (scale.next_up() - scale) * T::from_f64(end_ulps as f64)
+        .fold(T::ZERO, |a, b| a.max(b))
 }
 
 /// The termination test of one search, with what depends only on the root box and the
@@ -182,6 +235,14 @@ struct Stop<T> {
     /// The mantissa distance of §2.7.2 when the patch is rational.
     rational_dist: Option<u32>,
     criterion: Criterion<T>,
+    /// [`SubdivisionConfig::full_precision_splits`].
+    full_precision_splits: Option<u32>,
+    /// Where the coarsened end game starts: [`COARSEN_BASE_ULPS`] ulps of the root box's
+    /// largest coordinate magnitude.
+    coarse_base: T,
+    /// Largest magnitude of a ray direction component: a box of extent `e` (largest edge)
+    /// spans at most `e / dir_max` of `t` along the ray in its largest coordinate.
+    dir_max: T,
 }
 
 /// The part of [`Termination`] beyond the guards, in the search's float type.
@@ -212,11 +273,27 @@ impl<T: KernelFloat> Stop<T> {
                 Criterion::Adaptive(T::from_f64(fp.half_pixel as f64) * along)
             }
         };
+        let scale = root_scale(root);
+        let ulp = scale.next_up() - scale;
         Stop {
-            end_diameter: end_game_diameter(root, cfg.end_ulps).max(floor),
+            end_diameter: (ulp * T::from_f64(cfg.end_ulps as f64)).max(floor),
             rational_dist: rational.then_some(cfg.rational_dist),
             criterion,
+            full_precision_splits: cfg.full_precision_splits,
+            coarse_base: ulp * T::from_f64(COARSEN_BASE_ULPS as f64),
+            dir_max: ray.dir.iter().fold(T::ZERO, |a, &d| a.max(d).max(-d)),
         }
+    }
+
+    /// How much smaller than a final box's entry `t` a hit must be to lie outside the box's
+    /// extent (its largest edge) from the box's entry point, in the max norm the stability
+    /// suite compares points in.
+    #[inline(always)]
+    fn extent_along_ray(&self, b: &GBox<T>) -> T {
+        let extent = (0..3)
+            .map(|i| b.max[i] - b.min[i])
+            .fold(T::ZERO, |a, e| a.max(e));
+        extent / self.dir_max
     }
 
     /// Whether a child box `b` of a parent with L1 diameter `parent_diameter`, with
@@ -237,5 +314,110 @@ impl<T: KernelFloat> Stop<T> {
                 Criterion::Depth(d) => lu as u32 + lv as u32 >= d as u32,
                 Criterion::Adaptive(k) => bd <= k * t_enter,
             }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DVec3, Vec3};
+
+    use super::super::config::MAX_SPLITS_PER_TEST;
+    use super::super::{PreparedPatch, SubdivisionConfig, intersect};
+    use crate::geom::{BezierPatch, Ray};
+    use crate::kernel::{KernelStats, PatchHit};
+
+    /// The plane z = SLOPE_X x + SLOPE_Y y, tilted so that the boxes of its pieces are
+    /// thick in every axis (a grazing ray then hits many of them on every level).
+    const SLOPE_X: f64 = 0.5;
+    const SLOPE_Y: f64 = 0.3;
+
+    fn plane_z(x: f64, y: f64) -> f64 {
+        SLOPE_X * x + SLOPE_Y * y
+    }
+
+    /// A bicubic patch on the plane over [0,1]² (a linear map of the parameters, so the
+    /// control points lie on the plane; all are exact in `f32` but for the rounding of z).
+    fn plane_patch() -> PreparedPatch {
+        let pts: Vec<DVec3> = (0..16)
+            .map(|k| {
+                let (x, y) = ((k % 4) as f64 / 3.0, (k / 4) as f64 / 3.0);
+                DVec3::new(x, y, plane_z(x, y))
+            })
+            .collect();
+        PreparedPatch::new(&BezierPatch::from_points(3, 3, &pts).unwrap())
+    }
+
+    /// A ray at `angle` (radians) to the plane, from outside the patch, crossing the plane
+    /// over the patch's centre after running along it over most of the patch.
+    fn grazing_ray(angle: f64) -> Ray {
+        let normal = DVec3::new(-SLOPE_X, -SLOPE_Y, 1.0).normalize();
+        let along = DVec3::new(1.0, 0.0, SLOPE_X).normalize();
+        let target = DVec3::new(0.5, 0.5, plane_z(0.5, 0.5));
+        let dir = along * angle.cos() - normal * angle.sin();
+        let origin = target - dir;
+        Ray::new(origin.as_vec3(), dir.as_vec3())
+    }
+
+    fn run(ray: &Ray, cfg: &SubdivisionConfig) -> (Option<PatchHit>, u64) {
+        let mut stats = KernelStats::default();
+        let hit = intersect(&plane_patch(), ray, cfg, &mut stats);
+        (hit, stats.splits)
+    }
+
+    /// Distance of a point from the plane, in `f64`.
+    fn plane_distance(p: Vec3) -> f64 {
+        let p = p.as_dvec3();
+        (p.z - plane_z(p.x, p.y)).abs() / DVec3::new(SLOPE_X, SLOPE_Y, 1.0).length()
+    }
+
+    #[test]
+    fn grazing_ray_splits_stay_within_the_bound_and_hit_within_the_box() {
+        // 1e-4 rad: about 10^4 boxes per level along the stretch where the ray runs within
+        // a box size of the plane.
+        // In world space (secondary rays): a primary ray's ray-space boxes are tight across
+        // the ray, so there the same ray needs few splits (checked below).
+        let ray = grazing_ray(1e-4);
+        let world = SubdivisionConfig {
+            ray_space: false,
+            ..SubdivisionConfig::default()
+        };
+        let unbounded = SubdivisionConfig {
+            full_precision_splits: None,
+            ..world
+        };
+        let (_, splits_unbounded) = run(&ray, &unbounded);
+        assert!(
+            splits_unbounded > MAX_SPLITS_PER_TEST,
+            "the case must need the budget: {splits_unbounded} splits"
+        );
+        let (in_ray_space, ray_space_splits) = run(&ray, &SubdivisionConfig::default());
+        assert!(in_ray_space.is_some() && ray_space_splits < MAX_SPLITS_PER_TEST);
+        let (hit, splits) = run(&ray, &world);
+        assert!(splits <= MAX_SPLITS_PER_TEST, "{splits} splits");
+        let hit = hit.expect("the ray crosses the patch: no hole");
+        let p = ray.origin + ray.dir * hit.t;
+        let extent = hit.hit_box.extent().max_element() as f64;
+        // The reported point is the box's entry point, so within the box's extent (plus
+        // the f32 rounding of the plane's control points, an ulp of 1) of the plane.
+        assert!(
+            plane_distance(p) <= extent + f32::EPSILON as f64,
+            "{hit:?}: {} from the plane",
+            plane_distance(p)
+        );
+    }
+
+    #[test]
+    fn steep_rays_never_reach_the_budget() {
+        for angle in [0.1, 0.5, 1.5] {
+            let ray = grazing_ray(angle);
+            let unbounded = SubdivisionConfig {
+                full_precision_splits: None,
+                ..SubdivisionConfig::default()
+            };
+            let (want, splits) = run(&ray, &unbounded);
+            assert!(splits < super::super::config::DEFAULT_FULL_PRECISION_SPLITS as u64);
+            assert_eq!(run(&ray, &SubdivisionConfig::default()).0, want);
+            assert!(want.is_some());
+        }
     }
 }
