@@ -426,25 +426,8 @@ fn search_avx512(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::BezierPatch;
-    use crate::kernel::subdivision::register::search_register;
-    use glam::DVec3;
-
-    /// A curved bicubic patch with unequal edges, so both split directions (and so both
-    /// orientations of the registers) occur.
-    fn patch() -> BezierPatch {
-        let pts: Vec<DVec3> = (0..16)
-            .map(|k| {
-                let (i, j) = ((k % 4) as f64, (k / 4) as f64);
-                DVec3::new(
-                    1.6 * i + 0.3 * (j * 1.7).sin(),
-                    j * 1.1 - 0.2 * i * i,
-                    (i * 0.9 - j).cos(),
-                )
-            })
-            .collect();
-        BezierPatch::from_points(3, 3, &pts).unwrap()
-    }
+    use crate::kernel::subdivision::bicubic::tests::patch;
+    use crate::kernel::subdivision::register::{LaneNet, search_register};
 
     /// Random rays from above aimed at the patch's neighbourhood, by a fixed xorshift32.
     fn rays() -> Vec<GRay<f32>> {
@@ -457,7 +440,7 @@ mod tests {
         };
         (0..2000)
             .map(|_| {
-                let target = [6.0 * uniform() - 0.5, 5.0 * uniform() - 2.0, 0.0];
+                let target = [4.0 * uniform() - 0.5, 4.5 * uniform() - 1.0, 0.0];
                 let origin = [
                     8.0 * uniform() - 4.0,
                     8.0 * uniform() - 4.0,
@@ -469,23 +452,27 @@ mod tests {
             .collect()
     }
 
-    const ROOT: GBox<f32> = GBox {
-        min: [-1.0, -2.5, -1.5],
-        max: [5.5, 3.5, 1.5],
-    };
+    /// The net, its box and the world-space configuration, or `None` (and a note) on a
+    /// CPU without AVX-512F, where the path cannot run.
+    fn setup() -> Option<(Net, GBox<f32>, SubdivisionConfig)> {
+        if !available() {
+            eprintln!("skipped: this CPU has no AVX-512F");
+            return None;
+        }
+        let net = Net::from_patch(&patch());
+        let world = SubdivisionConfig {
+            ray_space: false,
+            ..SubdivisionConfig::default()
+        };
+        Some((net, net.bounds(), world))
+    }
 
     /// In world space the AVX-512 net must give exactly the SSE net's search (the same
     /// splits, the same boxes, the same hits): the same arithmetic in another layout.
     #[test]
     fn world_space_search_is_bit_identical_to_the_sse_search() {
-        if !available() {
-            eprintln!("skipped: this CPU has no AVX-512F");
+        let Some((net, root, cfg)) = setup() else {
             return;
-        }
-        let net = Net::from_patch(&patch());
-        let cfg = SubdivisionConfig {
-            ray_space: false,
-            ..SubdivisionConfig::default()
         };
         let (mut hits, mut slots16, mut slots, mut nodes) = (0, Vec::new(), Vec::new(), Vec::new());
         for ray in rays() {
@@ -495,14 +482,14 @@ mod tests {
                     &net,
                     &mut slots16,
                     &mut nodes,
-                    ROOT,
+                    root,
                     &ray,
                     &cfg,
                     any_hit,
                     &mut s16,
                 );
                 let b = search_register(
-                    net, &mut slots, &mut nodes, ROOT, &ray, &cfg, any_hit, &mut s,
+                    net, &mut slots, &mut nodes, root, &ray, &cfg, any_hit, &mut s,
                 );
                 assert_eq!(
                     a.map(|h| (h.t, h.cell, h.bbox)),
@@ -521,20 +508,14 @@ mod tests {
     /// end game, and the two `t` differ by no more than the two final boxes' extents.
     #[test]
     fn ray_space_search_finds_the_world_space_hits() {
-        if !available() {
-            eprintln!("skipped: this CPU has no AVX-512F");
+        let Some((net, root, world_cfg)) = setup() else {
             return;
-        }
-        let net = Net::from_patch(&patch());
-        let world_cfg = SubdivisionConfig {
-            ray_space: false,
-            ..SubdivisionConfig::default()
         };
         let cfg = SubdivisionConfig::default();
         let (mut slots, mut nodes, mut stats) = (Vec::new(), Vec::new(), KernelStats::default());
         let mut search = |ray: &GRay<f32>, cfg: &SubdivisionConfig| {
             search_net16(
-                &net, &mut slots, &mut nodes, ROOT, ray, cfg, false, &mut stats,
+                &net, &mut slots, &mut nodes, root, ray, cfg, false, &mut stats,
             )
         };
         let mut hits = 0;

@@ -132,11 +132,13 @@ impl LaneNet for Net {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use glam::DVec3;
 
-    fn patch() -> BezierPatch {
+    /// A curved bicubic patch with unequal edges, so both split directions (and so both
+    /// orientations of the registers) occur.
+    pub(crate) fn patch() -> BezierPatch {
         let pts: Vec<DVec3> = (0..16)
             .map(|k| {
                 let (i, j) = ((k % 4) as f64, (k / 4) as f64);
