@@ -22,9 +22,14 @@
 //! transformed edges are bit-identical too, and the union of the transformed nets'
 //! surfaces has no gap for the z-axis to pass through. This holds per ray, so a ray must
 //! search every patch in the same space: ray space is a property of the ray (primary rays,
-//! [`super::SubdivisionConfig::ray_space`]), never of the patch. Secondary rays keep
+//! [`super::SubdivisionConfig::ray_space`]), not of the patch. Secondary rays keep
 //! Dammertz's world-space search, because their origins are corners of world-space hit
-//! boxes (§2.4) whose subdivision must be the same for every ray.
+//! boxes (§2.4) whose subdivision must be the same for every ray. The one per-patch
+//! exception is [`MIN_RAY_SPACE_SCALE`]: a patch whose ray-space coordinates are all below
+//! 2^-39 (geometry within about 2^-39 |d| of the ray origin, e.g. the teapot scaled by 1e-18
+//! in front of a unit camera) is searched in world space. Two neighbours straddle that
+//! threshold only at such scales, and only there can their shared edge differ by the
+//! transform's rounding.
 //!
 //! Precision. The transformed points are rounded to ulps of their distance from the ray
 //! origin, while the world net is exact only to ulps of its own coordinates: the end game
