@@ -338,6 +338,10 @@ mod tests {
     const SLOPE_X: f64 = 0.5;
     const SLOPE_Y: f64 = 0.3;
 
+    /// The angle (radians) between the test's grazing ray and the plane: small enough that
+    /// an unbudgeted world-space search exceeds the split bound.
+    const GRAZING_ANGLE: f64 = 1e-4;
+
     fn plane_z(x: f64, y: f64) -> f64 {
         SLOPE_X * x + SLOPE_Y * y
     }
@@ -379,11 +383,11 @@ mod tests {
 
     #[test]
     fn grazing_ray_splits_stay_within_the_bound_and_hit_within_the_box() {
-        // 1e-4 rad: about 10^4 boxes per level along the stretch where the ray runs within
-        // a box size of the plane.
+        // About 1/GRAZING_ANGLE boxes per level along the stretch where the ray runs
+        // within a box size of the plane.
         // In world space (secondary rays): a primary ray's ray-space boxes are tight across
         // the ray, so there the same ray needs few splits (checked below).
-        let ray = grazing_ray(1e-4);
+        let ray = grazing_ray(GRAZING_ANGLE);
         let world = SubdivisionConfig {
             ray_space: false,
             ..SubdivisionConfig::default()
