@@ -12,7 +12,13 @@
 //!   butterfly within the quarters;
 //! - both slab tests run in one register (both children, both bounds, three axes), with
 //!   exactly the operations of [`crate::geom::bbox::slab`], so hits are bit-identical to
-//!   the SSE path's.
+//!   the SSE path's;
+//! - for primary rays the net is first moved into ray space ([`super::ray_space`]), where
+//!   both children's box tests are one comparison of the register against the ray's
+//!   bounds (exact, no rounding).
+//!
+//! The net is re-laid out from the SSE one ([`super::bicubic::Net`], kept per patch) at
+//! the start of each search: a dozen loads against the ~55 splits of a search.
 //!
 //! The arithmetic of the split is the same sequence of roundings as
 //! `geom::bezier::split_curve_half`, so neighbouring patches' shared edges stay
