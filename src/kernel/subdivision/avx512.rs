@@ -27,13 +27,13 @@
 use std::arch::x86_64::*;
 
 use super::bicubic::Net;
-use super::config::{SubdivisionConfig, Termination};
+use super::config::Termination;
 use super::float::{GBox, GRay};
 use super::heuristics::Corners;
 use super::param::Split;
 use super::ray_space::{MIN_RAY_SPACE_SCALE, RayFrame};
-use super::register::{ChildTests, RegisterNet, RegisterStack};
-use super::search::{Node, SearchHit, end_game_diameter, search};
+use super::register::{ChildTests, Query, RegisterNet, RegisterStack, Scratch};
+use super::search::{SearchHit, end_game_diameter, search};
 use crate::geom::bbox::SLAB_FAR_SCALE;
 use crate::kernel::KernelStats;
 
@@ -365,32 +365,27 @@ impl RegisterNet for Net16 {
 ///
 /// # Panics
 /// Never on a CPU where [`available`] is true; callers check it first.
-#[allow(clippy::too_many_arguments)]
 pub fn search_net16(
     net: &Net,
-    slots: &mut Vec<Net16>,
-    nodes: &mut Vec<Node<f32>>,
-    root: GBox<f32>,
-    ray: &GRay<f32>,
-    cfg: &SubdivisionConfig,
-    any_hit: bool,
+    scratch: &mut Scratch<Net16>,
+    q: Query,
     stats: &mut KernelStats,
 ) -> Option<SearchHit<f32>> {
     assert!(available(), "the AVX-512 kernel path needs AVX-512F");
     // SAFETY: the CPU has AVX-512F (asserted above).
-    unsafe { search_avx512(net, slots, nodes, root, ray, cfg, any_hit, stats) }
+    unsafe { search_avx512(net, scratch, q, stats) }
 }
 
-#[allow(clippy::too_many_arguments)]
 #[target_feature(enable = "avx512f")]
 fn search_avx512(
     net: &Net,
-    slots: &mut Vec<Net16>,
-    nodes: &mut Vec<Node<f32>>,
-    root: GBox<f32>,
-    ray: &GRay<f32>,
-    cfg: &SubdivisionConfig,
-    any_hit: bool,
+    (slots, nodes): &mut Scratch<Net16>,
+    Query {
+        root,
+        ray,
+        cfg,
+        any_hit,
+    }: Query,
     stats: &mut KernelStats,
 ) -> Option<SearchHit<f32>> {
     let world = Net16::from_net(net);
@@ -432,6 +427,7 @@ fn search_avx512(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::kernel::subdivision::SubdivisionConfig;
     use crate::kernel::subdivision::bicubic::tests::patch;
     use crate::kernel::subdivision::register::{LaneNet, search_register};
 
@@ -480,23 +476,18 @@ mod tests {
         let Some((net, root, cfg)) = setup() else {
             return;
         };
-        let (mut hits, mut slots16, mut slots, mut nodes) = (0, Vec::new(), Vec::new(), Vec::new());
+        let (mut hits, mut scratch16, mut scratch) = (0, Default::default(), Default::default());
         for ray in rays() {
             for any_hit in [false, true] {
                 let (mut s16, mut s) = (KernelStats::default(), KernelStats::default());
-                let a = search_net16(
-                    &net,
-                    &mut slots16,
-                    &mut nodes,
+                let q = Query {
                     root,
-                    &ray,
-                    &cfg,
+                    ray: &ray,
+                    cfg: &cfg,
                     any_hit,
-                    &mut s16,
-                );
-                let b = search_register(
-                    net, &mut slots, &mut nodes, root, &ray, &cfg, any_hit, &mut s,
-                );
+                };
+                let a = search_net16(&net, &mut scratch16, q, &mut s16);
+                let b = search_register(net, &mut scratch, q, &mut s);
                 assert_eq!(
                     a.map(|h| (h.t, h.cell, h.bbox)),
                     b.map(|h| (h.t, h.cell, h.bbox))
@@ -518,11 +509,15 @@ mod tests {
             return;
         };
         let cfg = SubdivisionConfig::default();
-        let (mut slots, mut nodes, mut stats) = (Vec::new(), Vec::new(), KernelStats::default());
+        let (mut scratch, mut stats) = (Default::default(), KernelStats::default());
         let mut search = |ray: &GRay<f32>, cfg: &SubdivisionConfig| {
-            search_net16(
-                &net, &mut slots, &mut nodes, root, ray, cfg, false, &mut stats,
-            )
+            let q = Query {
+                root,
+                ray,
+                cfg,
+                any_hit: false,
+            };
+            search_net16(&net, &mut scratch, q, &mut stats)
         };
         let mut hits = 0;
         for ray in rays() {

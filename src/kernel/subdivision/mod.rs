@@ -48,26 +48,23 @@ use bilinear::BilinearNet;
 use float::{GBox, GRay};
 use general::{GeneralStack, Scratch};
 use prepared::Prepared;
-use register::search_register;
+use register::{Query, search_register};
 use search::{SearchHit, search};
 
 use crate::geom::ulp::ulp_of;
 use crate::geom::{Aabb, Ray};
 use crate::kernel::{KernelStats, PatchHit};
 
-/// The net slots and the search nodes of a fast-path search.
-type RegisterScratch<N> = (Vec<N>, Vec<search::Node<f32>>);
-
 thread_local! {
     /// Per-thread buffers of the bicubic path: the pushed nets and the search nodes.
-    static BICUBIC_SCRATCH: RefCell<RegisterScratch<Net>> =
+    static BICUBIC_SCRATCH: RefCell<register::Scratch<Net>> =
         const { RefCell::new((Vec::new(), Vec::new())) };
     /// Per-thread buffers of the bicubic path on AVX-512.
     #[cfg(target_arch = "x86_64")]
-    static BICUBIC16_SCRATCH: RefCell<RegisterScratch<avx512::Net16>> =
+    static BICUBIC16_SCRATCH: RefCell<register::Scratch<avx512::Net16>> =
         const { RefCell::new((Vec::new(), Vec::new())) };
     /// Per-thread buffers of the bilinear path.
-    static BILINEAR_SCRATCH: RefCell<RegisterScratch<BilinearNet>> =
+    static BILINEAR_SCRATCH: RefCell<register::Scratch<BilinearNet>> =
         const { RefCell::new((Vec::new(), Vec::new())) };
     /// Per-thread buffers of the general path.
     static GENERAL_SCRATCH: RefCell<Scratch<f32>> = RefCell::new(Scratch::default());
@@ -136,19 +133,23 @@ fn run(
         ray.tmax,
     );
     let root = GBox::from_aabb(patch.bounds);
+    let query = Query {
+        root,
+        ray: &gray,
+        cfg,
+        any_hit,
+    };
     match &patch.data {
         #[cfg(target_arch = "x86_64")]
         Prepared::Bicubic(net) if avx512::available() => {
-            BICUBIC16_SCRATCH.with_borrow_mut(|(slots, nodes)| {
-                avx512::search_net16(net, slots, nodes, root, &gray, cfg, any_hit, stats)
-            })
+            BICUBIC16_SCRATCH.with_borrow_mut(|s| avx512::search_net16(net, s, query, stats))
         }
-        Prepared::Bicubic(net) => BICUBIC_SCRATCH.with_borrow_mut(|(slots, nodes)| {
-            search_register(*net, slots, nodes, root, &gray, cfg, any_hit, stats)
-        }),
-        Prepared::Bilinear(net) => BILINEAR_SCRATCH.with_borrow_mut(|(slots, nodes)| {
-            search_register(*net, slots, nodes, root, &gray, cfg, any_hit, stats)
-        }),
+        Prepared::Bicubic(net) => {
+            BICUBIC_SCRATCH.with_borrow_mut(|s| search_register(*net, s, query, stats))
+        }
+        Prepared::Bilinear(net) => {
+            BILINEAR_SCRATCH.with_borrow_mut(|s| search_register(*net, s, query, stats))
+        }
         Prepared::General { net, shape } => GENERAL_SCRATCH.with_borrow_mut(|s| {
             let mut nets = GeneralStack::new(&mut s.nets, net, *shape);
             search(

@@ -199,79 +199,74 @@ impl<N: RegisterNet> NetStack<f32> for RegisterStack<'_, N> {
     }
 }
 
+/// What one search of a register net is asked: the net's root box, the ray, the settings,
+/// and whether any hit will do (shadow rays).
+#[derive(Clone, Copy, Debug)]
+pub struct Query<'a> {
+    pub root: GBox<f32>,
+    pub ray: &'a GRay<f32>,
+    pub cfg: &'a SubdivisionConfig,
+    pub any_hit: bool,
+}
+
+/// The reusable buffers of a register-net search: the pushed nets and the search nodes.
+pub type Scratch<N> = (Vec<N>, Vec<Node<f32>>);
+
 /// The search of [`super::search`] on a register net, compiled for the best instruction set
 /// the CPU offers (see the module documentation).
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub fn search_register<N: RegisterNet>(
     net: N,
-    slots: &mut Vec<N>,
-    nodes: &mut Vec<Node<f32>>,
-    root: GBox<f32>,
-    ray: &GRay<f32>,
-    cfg: &SubdivisionConfig,
-    any_hit: bool,
+    scratch: &mut Scratch<N>,
+    q: Query,
     stats: &mut KernelStats,
 ) -> Option<SearchHit<f32>> {
     #[cfg(target_arch = "x86_64")]
     {
         if is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl") {
             // SAFETY: the CPU has the features the function is compiled for.
-            return unsafe { search_avx512(net, slots, nodes, root, ray, cfg, any_hit, stats) };
+            return unsafe { search_avx512(net, scratch, q, stats) };
         }
         if is_x86_feature_detected!("avx2") {
             // SAFETY: as above.
-            return unsafe { search_avx2(net, slots, nodes, root, ray, cfg, any_hit, stats) };
+            return unsafe { search_avx2(net, scratch, q, stats) };
         }
     }
-    search_portable(net, slots, nodes, root, ray, cfg, any_hit, stats)
+    search_portable(net, scratch, q, stats)
 }
 
 /// The search itself, inlined into each instruction-set version.
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn search_portable<N: RegisterNet>(
     net: N,
-    slots: &mut Vec<N>,
-    nodes: &mut Vec<Node<f32>>,
-    root: GBox<f32>,
-    ray: &GRay<f32>,
-    cfg: &SubdivisionConfig,
-    any_hit: bool,
+    (slots, nodes): &mut Scratch<N>,
+    q: Query,
     stats: &mut KernelStats,
 ) -> Option<SearchHit<f32>> {
-    let mut nets = RegisterStack::new(net, ray, slots);
-    search(&mut nets, nodes, root, ray, false, cfg, any_hit, stats)
+    let mut nets = RegisterStack::new(net, q.ray, slots);
+    search(
+        &mut nets, nodes, q.root, q.ray, false, q.cfg, q.any_hit, stats,
+    )
 }
 
 #[cfg(target_arch = "x86_64")]
-#[allow(clippy::too_many_arguments)]
 #[target_feature(enable = "avx2,avx512f,avx512vl")]
 fn search_avx512<N: RegisterNet>(
     net: N,
-    slots: &mut Vec<N>,
-    nodes: &mut Vec<Node<f32>>,
-    root: GBox<f32>,
-    ray: &GRay<f32>,
-    cfg: &SubdivisionConfig,
-    any_hit: bool,
+    scratch: &mut Scratch<N>,
+    q: Query,
     stats: &mut KernelStats,
 ) -> Option<SearchHit<f32>> {
-    search_portable(net, slots, nodes, root, ray, cfg, any_hit, stats)
+    search_portable(net, scratch, q, stats)
 }
 
 #[cfg(target_arch = "x86_64")]
-#[allow(clippy::too_many_arguments)]
 #[target_feature(enable = "avx2")]
 fn search_avx2<N: RegisterNet>(
     net: N,
-    slots: &mut Vec<N>,
-    nodes: &mut Vec<Node<f32>>,
-    root: GBox<f32>,
-    ray: &GRay<f32>,
-    cfg: &SubdivisionConfig,
-    any_hit: bool,
+    scratch: &mut Scratch<N>,
+    q: Query,
     stats: &mut KernelStats,
 ) -> Option<SearchHit<f32>> {
-    search_portable(net, slots, nodes, root, ray, cfg, any_hit, stats)
+    search_portable(net, scratch, q, stats)
 }
