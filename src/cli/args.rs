@@ -262,7 +262,7 @@ pub struct KernelArgs {
     #[arg(long)]
     pub isrt: bool,
     /// Surface-tree cache of `--kernel cached` per worker thread, in MiB (Lischinski &
-    /// Gonczarowski §4.3; default 8). Only with `--kernel cached`.
+    /// Gonczarowski §4.3; default 32). Only with `--kernel cached`.
     #[arg(long, value_name = "MIB")]
     pub cache_size: Option<usize>,
     /// Deepest cached level of the surface trees of `--kernel cached`; deeper boxes are

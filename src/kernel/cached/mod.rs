@@ -30,10 +30,12 @@ use lru::Lru;
 use tree::SurfaceTree;
 
 /// Cache budget per worker thread, in bytes. LG90 ran with 500K–1000K (Table 1). Our
-/// nodes are 64 bytes (`f64` parameter boxes, an `f32` box, a child index); the 512² teapot
-/// grows about 3 MiB of trees per worker at [`DEFAULT_MAX_DEPTH`] (BENCHMARKS.md, Issue 6),
-/// so 8 MiB holds it with room to spare while staying small next to a scene's own memory.
-pub const DEFAULT_CACHE_BYTES: usize = 8 << 20;
+/// nodes are 72 bytes (`f64` parameter boxes, an `f32` box, a child index, a sub-net slot)
+/// and each leaf keeps its sub-net (272 bytes for a bicubic patch, [`tree::LeafNet`]); LG90
+/// test case 1 at 512² (one teapot) grows about 90 k nodes, some 22 MiB, in a single worker
+/// at [`DEFAULT_MAX_DEPTH`] (BENCHMARKS.md, Issue 6), so 32 MiB holds it without evictions
+/// while staying small next to a machine's memory.
+pub const DEFAULT_CACHE_BYTES: usize = 32 << 20;
 
 /// Depth below which tree nodes are not cached (the paper's conclusion, §8). Depth 6
 /// leaves are 1/64 of the domain on a side: at 512² a teapot patch covers about 50 × 50

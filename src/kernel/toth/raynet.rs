@@ -10,7 +10,7 @@
 //! The plane coefficients are computed in interval arithmetic from the exact `f32` ray, so
 //! the projected net encloses the exact one and every bound derived from it is rigorous.
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 
 use crate::geom::Ray;
 use crate::geom::interval::{IPoint, Interval, IntervalNet};
@@ -90,6 +90,44 @@ impl RayFrame {
         );
     }
 
+    /// Writes into `out` an enclosure of the projected net of a homogeneous net known only
+    /// to within `radius` of `centres` in each component (`|H_k − c_k| ≤ r_k`): each plane's
+    /// value at the centre, widened by `Σ_k |row_k| r_k`.
+    pub fn project_enclosed(
+        &self,
+        centres: &[Vec4],
+        radius: Vec4,
+        nu: usize,
+        nv: usize,
+        out: &mut IntervalNet,
+    ) {
+        let r = radius.as_dvec4().to_array();
+        // Upper bounds of the widening, every product and sum rounded up (all terms ≥ 0).
+        let spread = self.rows.map(|row| {
+            let e = (0..4).fold(0.0, |acc: f64, k| {
+                (acc + (row[k].mag() * r[k]).next_up()).next_up()
+            });
+            Interval::spanning(-e, e)
+        });
+        let w_spread = Interval::spanning(-r[W], r[W]);
+        out.assign(
+            nu,
+            nv,
+            centres.iter().map(|p| {
+                let c = p.as_dvec4().to_array();
+                let f = |row: &IPoint, e: Interval| {
+                    row[0] * c[0] + row[1] * c[1] + row[2] * c[2] + row[3] * c[3] + e
+                };
+                [
+                    f(&self.rows[0], spread[0]),
+                    f(&self.rows[1], spread[1]),
+                    f(&self.rows[2], spread[2]),
+                    Interval::point(c[W]) + w_spread,
+                ]
+            }),
+        );
+    }
+
     /// Bounds of the sub-patch whose projected net is `net`: the hull of `x / w` over the
     /// control points (positive weights make every point a convex combination of them).
     pub fn ray_box(&self, net: &IntervalNet) -> RayBox {
@@ -124,4 +162,46 @@ fn cross(a: [Interval; 3], b: [Interval; 3]) -> [Interval; 3] {
 
 fn dot(a: [Interval; 3], b: [Interval; 3]) -> Interval {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec4;
+
+    /// Every homogeneous point within the radius of a centre projects, by the exact-input
+    /// [`RayFrame::project`], into the enclosure [`RayFrame::project_enclosed`] gives.
+    #[test]
+    fn enclosed_projection_holds_every_point_within_the_radius() {
+        let ray = Ray::new(Vec3::new(0.3, -1.7, 2.5), Vec3::new(0.6, 0.2, -0.77));
+        let frame = RayFrame::new(&ray);
+        let centres: Vec<Vec4> = (0..4)
+            .map(|i| {
+                Vec4::new(
+                    i as f32 - 1.5,
+                    0.25 * i as f32,
+                    2.0 - i as f32,
+                    1.0 + 0.5 * i as f32,
+                )
+            })
+            .collect();
+        let radius = Vec4::new(0.5, 0.25, 0.125, 0.0625);
+        let mut enclosed = IntervalNet::default();
+        frame.project_enclosed(&centres, radius, 2, 2, &mut enclosed);
+        // The corners of each point's box: the projection is linear, so they bound it.
+        let mut exact = IntervalNet::default();
+        for signs in 0..16 {
+            let s = |k: usize| if signs >> k & 1 == 1 { 1.0 } else { -1.0 };
+            let corners: Vec<DVec4> = centres
+                .iter()
+                .map(|c| (*c + radius * Vec4::new(s(0), s(1), s(2), s(3))).as_dvec4())
+                .collect();
+            frame.project(&corners, 2, 2, &mut exact);
+            for (e, x) in enclosed.points().iter().zip(exact.points()) {
+                for k in 0..4 {
+                    assert!(x[k].is_subset_of(e[k]), "{:?} not in {:?}", x[k], e[k]);
+                }
+            }
+        }
+    }
 }

@@ -68,6 +68,14 @@ pub struct Nets {
     euclid_sub: IntervalNet,
 }
 
+impl Nets {
+    /// The sub-net [`examine_prepared`] reads: an enclosure of the patch's projected net
+    /// over the box being examined.
+    pub fn sub_mut(&mut self) -> &mut IntervalNet {
+        &mut self.sub
+    }
+}
+
 /// Per-thread buffers of the Toth kernel: the nets and the candidate list.
 #[derive(Default)]
 pub struct Scratch {
@@ -119,6 +127,13 @@ impl<'a> PatchRay<'a> {
     }
 }
 
+impl PatchRay<'_> {
+    /// The ray's frame the patch is projected into.
+    pub fn frame(&self) -> &RayFrame {
+        &self.frame
+    }
+}
+
 /// What [`examine`] found in one box.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Step {
@@ -137,7 +152,24 @@ pub enum Step {
 /// (7), or with `Goal::Any` and `cfg.isrt` the safe region alone (§6), with the
 /// triviality tests of §6 on the surface of origin. Counts a search iteration when the ray
 /// meets the box.
+#[inline]
 pub fn examine(
+    pr: &PatchRay,
+    nets: &mut Nets,
+    x: &ParamBox,
+    tmax: f64,
+    cfg: &TothConfig,
+    goal: Goal,
+    stats: &mut TothStats,
+) -> Step {
+    nets.projected.subnet_into(x, &mut nets.sub);
+    examine_prepared(pr, nets, x, tmax, cfg, goal, stats)
+}
+
+/// [`examine`] when [`Nets::sub_mut`] already holds an enclosure of the projected sub-net
+/// over `x` (the cached kernel projects a leaf's stored net instead of subdividing the
+/// patch's).
+pub fn examine_prepared(
     pr: &PatchRay,
     nets: &mut Nets,
     x: &ParamBox,
@@ -152,7 +184,6 @@ pub fn examine(
         homogeneous,
         euclid_sub,
     } = nets;
-    projected.subnet_into(x, sub);
     let rb = pr.frame.ray_box(sub);
     stats.box_tests += 1;
     if !rb.is_hit(pr.tmin, tmax) {
@@ -375,7 +406,8 @@ pub fn final_box(
     })
 }
 
-/// The `f32` box, rounded outward, of the patch over `region`.
+/// The `f32` box, rounded outward, of the patch over `region`; `sub` is left holding the
+/// homogeneous sub-net over `region` it was computed from.
 pub fn enclosure_box(
     patch: &BezierPatch,
     region: &ParamBox,
