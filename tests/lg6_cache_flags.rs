@@ -1,5 +1,6 @@
 //! `--cache-size` and `--cache-depth` size the surface-tree cache of `--kernel cached`;
 //! with any other kernel they would be silently ignored, so they are an error there.
+//! `bench lg90 --cache-size` sizes the cached methods of the paper's tables.
 
 mod common;
 
@@ -49,4 +50,52 @@ fn cache_flags_work_with_the_cached_kernel() {
     let o = render(&testdata("distorted_patch.ron"), &out, (8, 8), &extra);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(out.exists());
+}
+
+/// `bench lg90 --cache-size` sizes the cached methods' caches: zero is refused with a
+/// message naming the flag; a size runs the cached method, whose first test of each
+/// surface is a cache miss, so the table's row of misses is not zero.
+#[test]
+fn bench_lg90_takes_a_cache_size() {
+    let refused = run(&[
+        "bench",
+        "lg90",
+        "--size",
+        "8",
+        "--cases",
+        "1",
+        "--cache-size",
+        "0",
+    ]);
+    let err = stderr(&refused);
+    assert!(!refused.status.success());
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(err.contains("--cache-size"), "{err}");
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("t.csv");
+    let ok = run(&[
+        "bench",
+        "lg90",
+        "--size",
+        "8",
+        "--cases",
+        "1",
+        "--methods",
+        "SCAN",
+        "--threads",
+        "1",
+        "--cache-size",
+        "1",
+        "-q",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(ok.status.success(), "{}", stderr(&ok));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let misses: f64 = text
+        .lines()
+        .find(|l| l.contains(",SCAN,") && l.contains("cache misses / surface"))
+        .and_then(|l| l.split(',').nth(5)?.parse().ok())
+        .unwrap_or_else(|| panic!("no cache-miss row in\n{text}"));
+    assert!(misses > 0.0, "{misses} misses per surface");
 }

@@ -77,6 +77,12 @@ pub struct Lg90Args {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Surface-tree cache of the cached methods (SCAN, ITBUF, PEANO) per worker thread,
+    /// in MiB (default: render's, 32). LG90 ran with caches smaller than the trees
+    /// (Table 1: 500K–1000K), where the sampling order decides how often trees are
+    /// rebuilt.
+    #[arg(long, value_name = "MIB")]
+    pub cache_size: Option<usize>,
     /// Also write the tables as CSV to this file.
     #[arg(long, value_name = "FILE")]
     pub csv: Option<PathBuf>,

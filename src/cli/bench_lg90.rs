@@ -6,6 +6,7 @@ use std::process::ExitCode;
 use crate::bench::lg90::{self, CASES, Config, Method, report};
 use crate::cli::args::Lg90Args;
 use crate::cli::setup::thread_pool;
+use crate::kernel::cached::DEFAULT_CACHE_BYTES;
 use crate::render::renderer::progress_bar;
 use crate::scene::write::write_atomic;
 
@@ -33,7 +34,14 @@ pub fn run(args: Lg90Args) -> anyhow::Result<ExitCode> {
         Some(_) => None,
         None => Some(tempfile_dir()?),
     };
+    anyhow::ensure!(
+        args.cache_size != Some(0),
+        "--cache-size must be at least 1 (MiB)"
+    );
     let config = Config {
+        cache_bytes: args
+            .cache_size
+            .map_or(DEFAULT_CACHE_BYTES, |mib| mib.saturating_mul(1 << 20)),
         size: args.size,
         cases: args.cases.clone(),
         methods,

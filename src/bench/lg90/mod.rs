@@ -13,7 +13,7 @@ use indicatif::ProgressBar;
 
 use crate::accel::grid::DEFAULT_BUDGET_BYTES;
 use crate::accel::scene::{Precision, SceneGeometry};
-use crate::kernel::cached::{CachedConfig, DEFAULT_CACHE_BYTES, DEFAULT_MAX_DEPTH};
+use crate::kernel::cached::{CachedConfig, DEFAULT_MAX_DEPTH};
 use crate::kernel::secondary::DEFAULT_ULPS;
 use crate::kernel::toth::TothConfig;
 use crate::render::integrator::{Integrator, TraceSettings};
@@ -139,11 +139,11 @@ pub const METHODS: [Method; 5] = [
 ];
 
 impl Method {
-    /// The kernel path this method runs; a cached method gets a fresh cache (a new
+    /// The kernel path this method runs, a cached one with `cache_bytes` per worker; a cached method gets a fresh cache (a new
     /// [`CachedConfig`] empties the workers' caches), so cases do not share trees. The
     /// cached methods include ISRT's treatment of secondary rays, as the paper's do (their
     /// Newton starts per ray equal ISRT's in every table).
-    pub fn precision(&self) -> Precision {
+    pub fn precision(&self, cache_bytes: usize) -> Precision {
         let toth = |isrt| {
             Precision::Toth(TothConfig {
                 isrt,
@@ -158,7 +158,7 @@ impl Method {
                     isrt: true,
                     ..TothConfig::default()
                 },
-                DEFAULT_CACHE_BYTES,
+                cache_bytes,
                 DEFAULT_MAX_DEPTH,
             )),
         }
@@ -175,6 +175,8 @@ impl Method {
 
 /// What to run.
 pub struct Config {
+    /// Surface-tree cache of the cached methods per worker thread, in bytes.
+    pub cache_bytes: usize,
     /// Image edge (the paper's is [`PAPER_SIZE`]).
     pub size: u32,
     /// Case numbers, 1–5.
@@ -234,7 +236,7 @@ pub fn run(config: &Config, progress: &ProgressBar) -> Result<Vec<CaseResult>, L
         let mut runs = Vec::new();
         for method in &config.methods {
             progress.set_message(format!("case {} {}", case.number, method.name));
-            let precision = method.precision();
+            let precision = method.precision(config.cache_bytes);
             let integrator = Integrator {
                 scene: &scene,
                 geometry: &geometry,
