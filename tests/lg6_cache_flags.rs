@@ -57,29 +57,19 @@ fn cache_flags_work_with_the_cached_kernel() {
 /// surface is a cache miss, so the table's row of misses is not zero.
 #[test]
 fn bench_lg90_takes_a_cache_size() {
-    let refused = run(&[
-        "bench",
-        "lg90",
-        "--size",
-        "8",
-        "--cases",
-        "1",
-        "--cache-size",
-        "0",
-    ]);
+    let bench = |extra: &[&str]| {
+        let mut args = vec!["bench", "lg90", "--size", "8", "--cases", "1"];
+        args.extend_from_slice(extra);
+        run(&args)
+    };
+    let refused = bench(&["--cache-size", "0"]);
     let err = stderr(&refused);
     assert!(!refused.status.success());
     assert!(!err.contains("panicked"), "{err}");
     assert!(err.contains("--cache-size"), "{err}");
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("t.csv");
-    let ok = run(&[
-        "bench",
-        "lg90",
-        "--size",
-        "8",
-        "--cases",
-        "1",
+    let ok = bench(&[
         "--methods",
         "SCAN",
         "--threads",
