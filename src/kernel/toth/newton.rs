@@ -79,10 +79,10 @@ pub enum Newton {
 /// the box's midpoint, whose step Krawczyk's test has already computed; with `trivial`,
 /// stops as soon as that test proves the root lies before the ray's start.
 ///
-/// Only the triviality test proves something at the iterates, so only then are they
-/// evaluated in interval arithmetic; otherwise a plain `f64` evaluation gives the step
-/// (the interval evaluation's midpoints up to `f64` rounding, which the contraction's
-/// error bound already allows for).
+/// Only the triviality test proves something at the iterates, so only for it are they
+/// evaluated in interval arithmetic; a plain `f64` evaluation gives the step (the interval
+/// evaluation's midpoints up to `f64` rounding, which the contraction's error bound
+/// already allows for).
 pub fn simple_newton(net: &IntervalNet, safe: &SafeRegion, trivial: Option<&Trivial>) -> Newton {
     let region = &safe.region;
     let bound = |step: f64| ERROR_BOUND_SAFETY * safe.contraction / (1.0 - safe.contraction) * step;
@@ -103,20 +103,19 @@ pub fn simple_newton(net: &IntervalNet, safe: &SafeRegion, trivial: Option<&Triv
         if last <= NEWTON_STEP_LIMIT || iterations >= NEWTON_MAX_ITERATIONS {
             break last;
         }
-        let g = match trivial {
-            Some(test) => {
-                let (g, _, _) = net.eval(u, v);
-                if test.proves(&g, bound(last)) {
-                    return Newton::Trivial { iterations };
-                }
-                [g[G1].mid(), g[G2].mid()]
+        let g = eval_point(net, u, v);
+        // The test can only prove the root trivial where the iterate's own `t` is before
+        // `tmin` (its enclosure holds that `t`, up to rounding); only there is the iterate
+        // evaluated again in intervals. Skipping the test elsewhere costs no hit: a root
+        // after `tmin` is not trivial, and one Newton converges to before `tmin` is
+        // dropped by the caller's `t ≥ tmin`.
+        if let Some(test) = trivial.filter(|t| g[TAU] / g[W] < t.tmin) {
+            let (enclosure, _, _) = net.eval(u, v);
+            if test.proves(&enclosure, bound(last)) {
+                return Newton::Trivial { iterations };
             }
-            None => {
-                let g = eval_point(net, u, v);
-                [g[G1], g[G2]]
-            }
-        };
-        step = newton_step(&safe.inverse, g);
+        }
+        step = newton_step(&safe.inverse, [g[G1], g[G2]]);
     };
     let radius = bound(last);
     let around = |x: f64, side: Interval| {
