@@ -404,7 +404,7 @@ pub(crate) fn de_casteljau_point(points: &[DVec4], t: f64) -> DVec4 {
 }
 
 /// De Casteljau in any [`Real`] type, in place, over `[x, y, z, w]` points.
-fn de_casteljau_generic<T: Real>(work: &mut [[T; 4]], t: T) -> [T; 4] {
+pub(crate) fn de_casteljau_generic<T: Real>(work: &mut [[T; 4]], t: T) -> [T; 4] {
     let n = work.len();
     for k in 1..n {
         for i in 0..n - k {

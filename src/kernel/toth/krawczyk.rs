@@ -14,7 +14,7 @@
 //! when also `r = ‖I − Y G'(X)‖∞ < 1` the root is unique and the simple Newton iteration
 //! `x ← x − Y g(x)` is a contraction of `X` into itself with rate `r`: Toth's "safe region".
 
-use crate::geom::interval::{IPoint, Interval, IntervalNet, ParamBox};
+use crate::geom::interval::{Interval, IntervalNet, ParamBox};
 
 use super::raynet::{G1, G2};
 
@@ -26,18 +26,26 @@ pub type Mat2 = [[f64; 2]; 2];
 pub enum Classification {
     /// No root in the box.
     Excluded,
-    /// Exactly one root in the box, and it lies in `region` (`K`, inside the box). Simple
-    /// Newton with `inverse` converges to it from any point of the box, with rate at most
-    /// `contraction` (< 1).
-    Safe {
-        region: ParamBox,
-        contraction: f64,
-        inverse: Mat2,
-    },
+    /// Exactly one root in the box: a safe region.
+    Safe(SafeRegion),
     /// Undecided: every root of the box lies in `region` (`K ∩ X`, or `X` itself when the
     /// operator could not be formed: a singular Jacobian at the midpoint, or a degenerate
     /// box).
     Undecided { region: ParamBox },
+}
+
+/// A box with exactly one root, which lies in `region` (`K`, inside the box). Simple Newton
+/// with `inverse` converges to it from any point of the box, with rate at most
+/// `contraction` (< 1). The test has evaluated the equations at the box's midpoint
+/// `start`; `step` is simple Newton's first step `−Y g(start)` from there, so Newton does
+/// not evaluate that point again.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SafeRegion {
+    pub region: ParamBox,
+    pub contraction: f64,
+    pub inverse: Mat2,
+    pub start: (f64, f64),
+    pub step: [f64; 2],
 }
 
 /// Krawczyk's test of box `x` for the equations in components [`G1`], [`G2`] of `net`
@@ -75,11 +83,13 @@ pub fn classify(net: &IntervalNet, sub: &IntervalNet, x: &ParamBox) -> Classific
     let kbox = ParamBox { u: k[0], v: k[1] };
     match kbox.intersect(x) {
         None => Classification::Excluded,
-        Some(_) if kbox.is_subset_of(x) && contraction < 1.0 => Classification::Safe {
+        Some(_) if kbox.is_subset_of(x) && contraction < 1.0 => Classification::Safe(SafeRegion {
             region: kbox,
             contraction,
             inverse,
-        },
+            start: (yu, yv),
+            step: newton_step(&inverse, [g[G1].mid(), g[G2].mid()]),
+        }),
         Some(region) => Classification::Undecided { region },
     }
 }
@@ -95,9 +105,8 @@ pub fn invert(m: Mat2) -> Option<Mat2> {
     (det != 0.0 && r.iter().flatten().all(|x| x.is_finite())).then_some(r)
 }
 
-/// The simple Newton step `−Y g` at a point, from the enclosure `g` of the equations there.
-pub fn newton_step(inverse: &Mat2, g: &IPoint) -> [f64; 2] {
-    let (a, b) = (g[G1].mid(), g[G2].mid());
+/// The simple Newton step `−Y g` at a point where the equations take the values `[a, b]`.
+pub fn newton_step(inverse: &Mat2, [a, b]: [f64; 2]) -> [f64; 2] {
     [
         -(inverse[0][0] * a + inverse[0][1] * b),
         -(inverse[1][0] * a + inverse[1][1] * b),
@@ -150,11 +159,11 @@ mod tests {
         let (net, _) = setup();
         let x = ParamBox::UNIT;
         match classify(&net, &sub(&net, &x), &x) {
-            Classification::Safe {
+            Classification::Safe(SafeRegion {
                 region,
                 contraction,
                 ..
-            } => {
+            }) => {
                 // The ray is rounded to f32, so the root moves by f32 ulps of (0.3, 0.6).
                 assert!(
                     (region.u.mid() - 0.3).abs() < F32_RAY_ROOT_SHIFT

@@ -26,8 +26,8 @@ use crate::geom::{BezierPatch, DAabb, Ray};
 use crate::kernel::PatchHit;
 
 use super::TothConfig;
-use super::krawczyk::{Classification, classify, invert, newton_step};
-use super::newton::{Newton, Trivial, simple_newton};
+use super::krawczyk::{Classification, SafeRegion, classify, invert, newton_step};
+use super::newton::{Newton, Trivial, eval_point, simple_newton};
 use super::raynet::{G1, G2, RayBox, RayFrame};
 use super::stats::TothStats;
 
@@ -210,7 +210,9 @@ pub fn examine_prepared(
     let isrt = goal == Goal::Any && cfg.isrt;
     let trivial_here = pr.origin && rb.t.lo() < pr.tmin;
     let k_box = match class {
-        Classification::Safe { region, .. } if (trivial_here || isrt) && region != *x => {
+        Classification::Safe(SafeRegion { region, .. })
+            if (trivial_here || isrt) && region != *x =>
+        {
             Some(region)
         }
         _ => None,
@@ -233,11 +235,8 @@ pub fn examine_prepared(
             region,
             ray_box: rb,
         },
-        Classification::Safe {
-            region,
-            contraction,
-            inverse,
-        } => {
+        Classification::Safe(safe) => {
+            let region = safe.region;
             let kb = k_box.unwrap_or(rb);
             if isrt {
                 // ISRT: the safe region proves a root; its ray parameter lies in the
@@ -269,14 +268,7 @@ pub fn examine_prepared(
                 });
             stats.newton_starts += 1;
             stats.safe_width_sum += x.width();
-            match simple_newton(
-                projected,
-                x,
-                &region,
-                contraction,
-                &inverse,
-                trivial.as_ref(),
-            ) {
+            match simple_newton(projected, &safe, trivial.as_ref()) {
                 Newton::Converged(n) => {
                     stats.newton_iterations += n.iterations as u64;
                     ray_parameter(projected, n.u, n.v)
@@ -369,8 +361,8 @@ pub fn search(
 
 /// The ray parameter `τ / w` of the surface point at (u, v).
 fn ray_parameter(projected: &IntervalNet, u: f64, v: f64) -> Option<f64> {
-    let (p, _, _) = projected.eval(u, v);
-    let t = p[super::raynet::TAU].mid() / p[super::raynet::W].mid();
+    let p = eval_point(projected, u, v);
+    let t = p[super::raynet::TAU] / p[super::raynet::W];
     t.is_finite().then_some(t)
 }
 
@@ -388,7 +380,7 @@ pub fn final_box(
     let (mut u, mut v) = region.mid();
     let (g, gu, gv) = nets.projected.eval(u, v);
     if let Some(inv) = invert([[gu[G1].mid(), gv[G1].mid()], [gu[G2].mid(), gv[G2].mid()]]) {
-        let [du, dv] = newton_step(&inv, &g);
+        let [du, dv] = newton_step(&inv, [g[G1].mid(), g[G2].mid()]);
         if region.contains(u + du, v + dv) {
             (u, v) = (u + du, v + dv);
         }
