@@ -12,9 +12,7 @@ use crate::geom::interval::IntervalNet;
 use crate::geom::{BezierPatch, Ray};
 use crate::kernel::PatchHit;
 use crate::kernel::toth::TothStats;
-use crate::kernel::toth::search::{
-    self, Goal, Nets, PatchRay, Step, examine, examine_prepared, final_box,
-};
+use crate::kernel::toth::search::{self, Goal, Nets, PatchRay, Step, examine, final_box};
 
 use super::CachedConfig;
 use super::stats::CachedStats;
@@ -102,16 +100,15 @@ pub fn search(
         // A cached leaf's stored sub-net, projected into the ray's frame, replaces
         // subdividing the patch's projected net down to the leaf's box.
         let leaf = c.node.and_then(|i| tree.leaf_net(i));
-        let step = match leaf {
+        match leaf {
             Some(net) => {
                 let (nu, nv) = (patch.degree_u() + 1, patch.degree_v() + 1);
                 pr.frame()
                     .project_enclosed(net.centres, net.radius, nu, nv, s.nets.sub_mut());
-                examine_prepared(&pr, &mut s.nets, &c.region, tmax, &cfg.toth, goal, toth)
             }
-            None => examine(&pr, &mut s.nets, &c.region, tmax, &cfg.toth, goal, toth),
-        };
-        let hit = match step {
+            None => s.nets.subdivide_to(&c.region),
+        }
+        let hit = match examine(&pr, &mut s.nets, &c.region, tmax, &cfg.toth, goal, toth) {
             Step::Miss => None,
             Step::Hit(h) => Some(h),
             Step::Undecided { region, ray_box } => {

@@ -69,10 +69,17 @@ pub struct Nets {
 }
 
 impl Nets {
-    /// The sub-net [`examine_prepared`] reads: an enclosure of the patch's projected net
-    /// over the box being examined.
+    /// The sub-net [`examine`] reads, to be filled with an enclosure of the patch's
+    /// projected net over the box being examined (the cached kernel projects a leaf's
+    /// stored net into it).
     pub fn sub_mut(&mut self) -> &mut IntervalNet {
         &mut self.sub
+    }
+
+    /// Fills the sub-net [`examine`] reads by subdividing the patch's projected net down
+    /// to `x`.
+    pub fn subdivide_to(&mut self, x: &ParamBox) {
+        self.projected.subnet_into(x, &mut self.sub);
     }
 }
 
@@ -152,24 +159,9 @@ pub enum Step {
 /// (7), or with `Goal::Any` and `cfg.isrt` the safe region alone (§6), with the
 /// triviality tests of §6 on the surface of origin. Counts a search iteration when the ray
 /// meets the box.
-#[inline]
+///
+/// Reads the sub-net over `x` that [`Nets::subdivide_to`] or [`Nets::sub_mut`] filled.
 pub fn examine(
-    pr: &PatchRay,
-    nets: &mut Nets,
-    x: &ParamBox,
-    tmax: f64,
-    cfg: &TothConfig,
-    goal: Goal,
-    stats: &mut TothStats,
-) -> Step {
-    nets.projected.subnet_into(x, &mut nets.sub);
-    examine_prepared(pr, nets, x, tmax, cfg, goal, stats)
-}
-
-/// [`examine`] when [`Nets::sub_mut`] already holds an enclosure of the projected sub-net
-/// over `x` (the cached kernel projects a leaf's stored net instead of subdividing the
-/// patch's).
-pub fn examine_prepared(
     pr: &PatchRay,
     nets: &mut Nets,
     x: &ParamBox,
@@ -329,6 +321,7 @@ pub fn search(
             stats.cut_off += 1;
             break;
         }
+        s.nets.subdivide_to(&c.region);
         let hit = match examine(&pr, &mut s.nets, &c.region, tmax, cfg, goal, stats) {
             Step::Miss => None,
             Step::Hit(h) => Some(h),
