@@ -36,6 +36,8 @@ pub struct KernelStats {
     pub splits: u64,
     /// Ray–box tests inside the kernel.
     pub box_tests: u64,
+    /// Newton jumps of the subdivision kernel that landed (`subdivision::jump`).
+    pub jumps: u64,
     /// The Toth kernel's own counters (LG90 Tables 2–6 rows).
     pub toth: toth::TothStats,
     /// The cached kernel's cache counters (LG90 Tables 2–6 rows).
@@ -47,6 +49,7 @@ impl KernelStats {
         self.patch_tests += other.patch_tests;
         self.splits += other.splits;
         self.box_tests += other.box_tests;
+        self.jumps += other.jumps;
         self.toth.add(&other.toth);
         self.cached.add(&other.cached);
     }

@@ -28,9 +28,10 @@ use std::arch::x86_64::*;
 
 use super::bicubic::Net;
 use super::config::Termination;
-use super::float::{GBox, GRay};
+use super::float::{GBox, GRay, KernelFloat};
 use super::heuristics::Corners;
-use super::param::Split;
+use super::jump::{Jump, Linearization, plan};
+use super::param::{ParamCell, Split};
 use super::ray_space::{MIN_RAY_SPACE_SCALE, RayFrame};
 use super::register::{ChildTests, Query, RegisterNet, RegisterStack, Scratch};
 use super::search::{SearchHit, end_game_diameter, search};
@@ -130,6 +131,117 @@ impl Net16 {
     #[target_feature(enable = "avx512f")]
     fn bounds(&self) -> GBox<f32> {
         child_boxes(by_bound(boxes(&self.regs, &self.regs)))[0]
+    }
+
+    /// The net's [`Linearization`] (its definition is [`super::jump::linearize`]), from the
+    /// registers: register r holds row r (v = r) or, transposed, column r (u = r), so the
+    /// differences across registers are one parameter's derivative net and those across
+    /// the lanes of a quarter the other's. The means telescope to the end rows' sums.
+    #[target_feature(enable = "avx512f")]
+    fn linearization(&self) -> Linearization {
+        let r = self.regs;
+        let (add, sub, mul) = (_mm512_add_ps, _mm512_sub_ps, _mm512_mul_ps);
+        let splat = _mm512_set1_ps;
+        // Sums and maxima within each quarter, left in every lane of it.
+        let hsum = |v| {
+            let v = add(v, _mm512_shuffle_ps::<0xB1>(v, v));
+            add(v, _mm512_shuffle_ps::<0x4E>(v, v))
+        };
+        let hmax = |v| {
+            let v = _mm512_max_ps(v, _mm512_shuffle_ps::<0xB1>(v, v));
+            _mm512_max_ps(v, _mm512_shuffle_ps::<0x4E>(v, v))
+        };
+        let abs = |v| _mm512_abs_ps(v);
+        // Bernstein weights of degree 3 at 1/2, times 8, along the lanes.
+        let half = _mm512_setr_ps(
+            1.0, 3.0, 3.0, 1.0, 1.0, 3.0, 3.0, 1.0, 1.0, 3.0, 3.0, 1.0, 1.0, 3.0, 3.0, 1.0,
+        );
+        let rows = add(add(r[0], r[3]), mul(splat(3.0), add(r[1], r[2])));
+        let centre = mul(hsum(mul(rows, half)), splat(1.0 / 64.0));
+        // Across the registers: 3 (r[k+1] - r[k]), mean 3 Σ (r[3] - r[0]) / 12.
+        let across: [__m512; 3] = std::array::from_fn(|k| mul(splat(3.0), sub(r[k + 1], r[k])));
+        let across_mean = mul(hsum(sub(r[3], r[0])), splat(0.25));
+        let across_dev = hmax(_mm512_max_ps(
+            _mm512_max_ps(
+                abs(sub(across[0], across_mean)),
+                abs(sub(across[1], across_mean)),
+            ),
+            abs(sub(across[2], across_mean)),
+        ));
+        // Along the lanes: 3 (p[i+1] - p[i]) in lanes 0..3 of each quarter, lane 3 unused.
+        let next = |v| _mm512_shuffle_ps::<0xF9>(v, v);
+        let along: [__m512; 4] = std::array::from_fn(|k| mul(splat(3.0), sub(next(r[k]), r[k])));
+        let ends = |v| {
+            sub(
+                _mm512_shuffle_ps::<0xFF>(v, v),
+                _mm512_shuffle_ps::<0x00>(v, v),
+            )
+        };
+        let along_mean = mul(
+            add(add(ends(r[0]), ends(r[1])), add(ends(r[2]), ends(r[3]))),
+            splat(0.25),
+        );
+        let dev = |v| abs(sub(v, along_mean));
+        let along_dev = _mm512_max_ps(
+            _mm512_max_ps(dev(along[0]), dev(along[1])),
+            _mm512_max_ps(dev(along[2]), dev(along[3])),
+        );
+        // Lane 3 of each quarter is not a difference.
+        let along_dev = hmax(_mm512_maskz_mov_ps(0x7777, along_dev));
+        let xy = |v| {
+            let l = Net16::lanes(v);
+            [l[0], l[4]]
+        };
+        let (across, along) = (
+            (xy(across_mean), xy(across_dev)),
+            (xy(along_mean), xy(along_dev)),
+        );
+        // Not transposed, the registers run across v.
+        let ((du, du_dev), (dv, dv_dev)) = if self.transposed {
+            (across, along)
+        } else {
+            (along, across)
+        };
+        Linearization {
+            centre: xy(centre),
+            du,
+            dv,
+            du_dev,
+            dv_dev,
+        }
+    }
+
+    /// The sub-net of a jump: halvings towards the jumped-to cell, each choosing its half
+    /// by the index bit, with no box or test. The halvings are the search's own
+    /// ([`split4`]), the direction the registers run across first, so at most one
+    /// transpose.
+    #[target_feature(enable = "avx512f")]
+    fn descend(&self, jump: &Jump) -> Net16 {
+        let mut net = *self;
+        let first = if self.transposed { Split::U } else { Split::V };
+        let second = if first == Split::U {
+            Split::V
+        } else {
+            Split::U
+        };
+        for dir in [first, second] {
+            let d = usize::from(dir == Split::V);
+            let levels = jump.levels[d];
+            if levels == 0 {
+                continue;
+            }
+            if (dir == Split::V) == net.transposed {
+                net.regs = transpose(net.regs);
+                net.transposed = !net.transposed;
+            }
+            for level in (0..levels).rev() {
+                let (lo, hi) = split4(net.regs);
+                // All lanes from the upper half where the index bit is set.
+                let upper = 0u16.wrapping_sub(((jump.index[d] >> level) & 1) as u16);
+                net.regs = std::array::from_fn(|r| _mm512_mask_blend_ps(upper, lo[r], hi[r]));
+            }
+        }
+        net
     }
 
     fn lanes(v: __m512) -> [f32; 16] {
@@ -353,6 +465,27 @@ impl RegisterNet for Net16 {
     }
 
     #[inline(always)]
+    fn jump(
+        &self,
+        cell: ParamCell,
+        ray: &Ray16,
+        tmax: f32,
+    ) -> Option<(Net16, ParamCell, GBox<f32>, f32)> {
+        let Ray16::Axis { bounds, tmin } = *ray else {
+            return None;
+        };
+        let (lu, lv) = cell.levels();
+        // SAFETY: a Net16 exists only where AVX-512 is available (see `ray_registers`).
+        unsafe {
+            let jump = plan(&self.linearization(), [lu, lv].map(|l| f32::MAX_LEVEL - l))?;
+            let net = self.descend(&jump);
+            let b = by_bound(boxes(&net.regs, &net.regs));
+            let [(bbox, t), _] = axis_pair(b, bounds, tmin, tmax);
+            Some((net, jump.cell(cell), bbox, t?))
+        }
+    }
+
+    #[inline(always)]
     fn corners(&self) -> Corners<f32> {
         let first = Net16::lanes(self.regs[0]);
         let last = Net16::lanes(self.regs[3]);
@@ -558,5 +691,91 @@ mod tests {
             }
         }
         assert!(hits > 500, "{hits} hits");
+        // The ray-space searches jumped ([`super::super::jump`]); the world-space ones
+        // cannot, so the agreement above covers the jumps.
+        assert!(stats.jumps > 0, "no jumps");
+    }
+
+    /// The point `(i, j)`'s (x, y) of a net, read lane by lane (the layout of the module
+    /// documentation), for the scalar reference.
+    fn points_xy(net: &Net16) -> [[[f32; 2]; 4]; 4] {
+        let regs = net.regs.map(Net16::lanes);
+        std::array::from_fn(|j| {
+            std::array::from_fn(|i| {
+                let (r, lane) = if net.transposed { (i, j) } else { (j, i) };
+                [regs[r][lane], regs[r][4 + lane]]
+            })
+        })
+    }
+
+    /// The register linearisation is the scalar definition's, in both layouts, up to the
+    /// rounding of sums taken in another order.
+    #[test]
+    fn register_linearization_matches_the_scalar_definition() {
+        if !available() {
+            return;
+        }
+        let frame = RayFrame::new(&rays()[0]);
+        // SAFETY: AVX-512F is available (checked above).
+        let local = unsafe { Net16::from_net(&Net::from_patch(&patch())).in_ray_space(&frame) };
+        for transposed in [false, true] {
+            let net = if transposed {
+                // SAFETY: as above.
+                Net16 {
+                    regs: unsafe { transpose(local.regs) },
+                    transposed: !local.transposed,
+                }
+            } else {
+                local
+            };
+            // SAFETY: as above.
+            let got = unsafe { net.linearization() };
+            let want = crate::kernel::subdivision::jump::linearize(&points_xy(&net));
+            let pairs = [
+                (got.centre, want.centre),
+                (got.du, want.du),
+                (got.dv, want.dv),
+                (got.du_dev, want.du_dev),
+                (got.dv_dev, want.dv_dev),
+            ];
+            for (g, w) in pairs {
+                for c in 0..2 {
+                    assert!(
+                        (g[c] - w[c]).abs() <= 1e-5 * (1.0 + w[c].abs()),
+                        "transposed {transposed}: {got:?} vs {want:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// A jump's descent is the search's own halvings: the same net, bit for bit, as
+    /// splitting towards the sub-cell one level at a time.
+    #[test]
+    fn descent_is_the_halving_search_bit_for_bit() {
+        if !available() {
+            return;
+        }
+        // SAFETY: AVX-512F is available (checked above).
+        let root = unsafe { Net16::from_net(&Net::from_patch(&patch())) };
+        let ray = Net16::ray_registers(&rays()[0]);
+        for (levels, index) in [([3, 2], [5, 1]), ([0, 4], [0, 9]), ([6, 0], [37, 0])] {
+            let jump = Jump { levels, index };
+            // SAFETY: as above.
+            let got = unsafe { root.descend(&jump) };
+            let mut want = root;
+            // The descent's order: the direction the registers run across first.
+            for (d, dir) in [(1, Split::V), (0, Split::U)] {
+                for level in (0..levels[d]).rev() {
+                    let (upper, _) = want.split_test(dir, &ray, f32::INFINITY);
+                    if (index[d] >> level) & 1 == 1 {
+                        want = upper;
+                    }
+                }
+            }
+            assert_eq!(got.transposed, want.transposed, "{jump:?}");
+            let bits = |n: &Net16| n.regs.map(|r| Net16::lanes(r).map(f32::to_bits));
+            assert_eq!(bits(&got), bits(&want), "{jump:?}");
+        }
     }
 }

@@ -25,6 +25,7 @@ pub mod config;
 pub mod float;
 pub mod general;
 pub mod heuristics;
+pub mod jump;
 pub mod param;
 pub mod prepared;
 pub mod ray_space;

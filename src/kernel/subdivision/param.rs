@@ -69,6 +69,18 @@ impl ParamCell {
         }
     }
 
+    /// The sub-cell `levels` deeper in u and v at `index` (in units of the sub-cell's
+    /// width, from the cell's lower corner): where a jump ([`super::jump`]) lands.
+    pub fn sub_cell(&self, levels: [u8; 2], index: [u64; 2]) -> ParamCell {
+        let (level_u, level_v) = (self.level_u + levels[0], self.level_v + levels[1]);
+        ParamCell {
+            u0: self.u0 + (index[0] << (63 - level_u)),
+            v0: self.v0 + (index[1] << (63 - level_v)),
+            level_u,
+            level_v,
+        }
+    }
+
     /// Lower corner and width of the cell in u and v: `(u0, v0, wu, wv)`.
     pub fn bounds(&self) -> (f64, f64, f64, f64) {
         (

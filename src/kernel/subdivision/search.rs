@@ -53,6 +53,14 @@ pub trait NetStack<T: KernelFloat> {
     fn keep(&mut self, lower: bool);
     /// Drop the current net and continue with the most recently pushed one.
     fn pop(&mut self);
+    /// A jump ([`super::jump`]) from the current net, whose cell is `cell`: if the jumped-to
+    /// sub-cell's box is hit (entry `t` clipped to `tmax`), the current net is pushed (the
+    /// fallback), the sub-cell's net becomes current, and its cell, box and entry are
+    /// returned. `None` (nothing changed) where the storage has no jumps or the jump does
+    /// not apply.
+    fn try_jump(&mut self, _cell: ParamCell, _tmax: T) -> Option<(ParamCell, GBox<T>, T)> {
+        None
+    }
     /// An L1 diameter below which boxes are rounding noise of the net the stack's nets
     /// came from (a net transformed into another frame is no more precise than its
     /// source): the end game stops there at the latest. Zero for nets searched as built.
@@ -68,7 +76,23 @@ pub struct Node<T> {
     pub t_enter: T,
     pub cell: ParamCell,
     is_final: bool,
+    /// For the fallback of a jump, the number of hits the search had found when it was
+    /// pushed: it is searched only if the jump found none. [`NOT_A_FALLBACK`] otherwise.
+    fallback_after: u32,
+    /// The level (u + v) from which this node and its descendants try jumps: raised after
+    /// a jump that does not apply, so that the next few levels do not pay for it again.
+    jump_from: u8,
 }
+
+/// [`Node::fallback_after`] of a node searched like any other.
+const NOT_A_FALLBACK: u32 = u32::MAX;
+
+/// Jumps are tried from this many levels (u + v) on: above it the sub-patches of the
+/// teapot are rarely linear enough (BENCHMARKS.md, issue 3).
+const JUMP_FROM_LEVEL: u8 = 12;
+
+/// Levels (u + v) below a node whose jump did not apply before its descendants try again.
+const JUMP_RETRY_LEVELS: u8 = 2;
 
 /// A final box hit by the ray.
 #[derive(Clone, Copy, Debug)]
@@ -102,7 +126,10 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
         t_enter,
         cell: ParamCell::ROOT,
         is_final: false,
+        fallback_after: NOT_A_FALLBACK,
+        jump_from: JUMP_FROM_LEVEL,
     };
+    let mut hits_found = 0u32;
     let mut best: Option<SearchHit<T>> = None;
     let max = T::MAX_LEVEL;
     let stop = Stop::new(cfg, &root, ray, rational, nets.end_game_floor());
@@ -112,7 +139,9 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
     loop {
         // A popped entry was tested against an older, longer ray; after a hit only boxes
         // entered more than the hit box's extent before it matter (`tmax` is that bound).
-        let live = cur.t_enter <= tmax && (best.is_none() || cur.t_enter < tmax);
+        let live = cur.t_enter <= tmax
+            && (best.is_none() || cur.t_enter < tmax)
+            && (cur.fallback_after == NOT_A_FALLBACK || cur.fallback_after == hits_found);
         // A coarsened box is final only if the ray starts outside it (so a secondary ray
         // cannot take the coarse box around its own origin for a hit), until the last
         // doubling, after which every box is.
@@ -126,6 +155,7 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
                 bbox: cur.bbox,
             });
             tmax = cur.t_enter - stop.extent_along_ray(&cur.bbox);
+            hits_found += 1;
             if any_hit {
                 return best;
             }
@@ -145,8 +175,21 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
                     continue;
                 }
             }
-            splits += 1;
             let (lu, lv) = cur.cell.levels();
+            if lu + lv >= cur.jump_from && cur.fallback_after == NOT_A_FALLBACK {
+                if let Some((cell, bbox, t)) = nets.try_jump(cur.cell, tmax) {
+                    stats.jumps += 1;
+                    stats.box_tests += 1;
+                    nodes.push(Node {
+                        fallback_after: hits_found,
+                        ..cur
+                    });
+                    cur = stop.child(bbox, cell, cur.bbox.l1_diameter(), t, 0);
+                    continue;
+                }
+                cur.jump_from = lu + lv + JUMP_RETRY_LEVELS;
+            }
+            splits += 1;
             let dir = if lu >= max {
                 Split::V
             } else if lv >= max {
@@ -163,8 +206,8 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
             // Children are built by an always-inlined method, not a closure: the compiler
             // stopped inlining the closure when the search grew, and the call spilled every
             // vector register (a quarter of the bicubic search's time).
-            let lower = |t| stop.child(boxes[0], cells.0, d, t);
-            let upper = |t| stop.child(boxes[1], cells.1, d, t);
+            let lower = |t| stop.child(boxes[0], cells.0, d, t, cur.jump_from);
+            let upper = |t| stop.child(boxes[1], cells.1, d, t, cur.jump_from);
             match (hit0, hit1) {
                 (Some(t0), Some(t1)) => {
                     let far_is_lower = t1 < t0;
@@ -294,12 +337,21 @@ impl<T: KernelFloat> Stop<T> {
     /// The search node of a child box `bbox` with parameter cell `cell`, entered by the ray
     /// at `t_enter`, of a parent with L1 diameter `parent_diameter`.
     #[inline(always)]
-    fn child(&self, bbox: GBox<T>, cell: ParamCell, parent_diameter: T, t_enter: T) -> Node<T> {
+    fn child(
+        &self,
+        bbox: GBox<T>,
+        cell: ParamCell,
+        parent_diameter: T,
+        t_enter: T,
+        jump_from: u8,
+    ) -> Node<T> {
         Node {
             bbox,
             t_enter,
             cell,
             is_final: self.is_final(&bbox, parent_diameter, cell, t_enter),
+            fallback_after: NOT_A_FALLBACK,
+            jump_from,
         }
     }
 
