@@ -8,6 +8,12 @@
 //! [`Stop::is_final`]: a hit at its entry `t`, which shortens the ray so that farther stack
 //! entries are dropped.
 //!
+//! Where the net storage can ([`NetStack::try_jump`], the ray-space bicubic net), a node
+//! from [`JUMP_FROM_LEVEL`] levels on first tries a Newton jump ([`super::jump`]): when
+//! the sub-patch is linear enough for the crossing to be unique and located, the search
+//! goes straight to the dyadic sub-cell holding it, and the node stays on the stack as a
+//! fallback that is searched only if that sub-cell yields no hit.
+//!
 //! Two rules keep the work bounded. A ray at a small angle θ to the surface hits about 1/θ
 //! boxes on every level along the stretch where it runs close to the surface, and the
 //! nearest-first search must split each before it can reject it, so the work has no bound
