@@ -141,8 +141,7 @@ pub fn plan(lin: &Linearization, max_levels: [u8; 2]) -> Option<Jump> {
     if !det.is_normal() {
         return None;
     }
-    let r = 1.0 / det;
-    let inv = [[dv[1] * r, -dv[0] * r], [-du[1] * r, du[0] * r]];
+    let inv = [[dv[1] / det, -dv[0] / det], [-du[1] / det, du[0] / det]];
     // q = ‖|J₀⁻¹| E‖∞ with E = [eu ev] (columns).
     let q = (0..2)
         .map(|r| {
