@@ -93,8 +93,9 @@ pub struct Node<T> {
 /// [`Node::fallback_after`] of a node searched like any other.
 const NOT_A_FALLBACK: u32 = u32::MAX;
 
-/// Jumps are tried from this many levels (u + v) on: above it the sub-patches of the
-/// teapot are rarely linear enough (BENCHMARKS.md, issue 3).
+/// Jumps are tried from this many levels (u + v) on: on coarser cells the teapot's
+/// sub-patches are rarely linear enough for a jump, and the refused tries cost more than
+/// they save (measured from 6 to 14 levels, BENCHMARKS.md, issue 3).
 const JUMP_FROM_LEVEL: u8 = 12;
 
 /// Levels (u + v) below a node whose jump did not apply before its descendants try again.
