@@ -140,10 +140,11 @@ fn main() {
         median / n * 1e9
     );
     println!(
-        "splits/test: mean {:.1}, max {}; jumps/test {:.2}; box tests/test {:.1}; {:.1} ns/split",
+        "splits/test: mean {:.1}, max {}; jumps/test {:.2} (+ {:.2} cells dropped); box tests/test {:.1}; {:.1} ns/split",
         stats.splits as f64 / n,
         max_splits,
         stats.jumps as f64 / n,
+        stats.jump_drops as f64 / n,
         stats.box_tests as f64 / n,
         median / stats.splits as f64 * 1e9
     );

@@ -24,6 +24,8 @@ fn ray_counts_by_type_follow_the_effect_plan() {
     assert!(s["rays"]["reflection"].as_u64().unwrap() > 0);
     assert_eq!(s["rays"]["refraction"], 0);
     assert_eq!(s["plan"]["refraction"], false);
+    // Primary rays search the patches in ray space, where the kernel jumps.
+    assert!(s["rays"]["jumps_per_ray"]["mean"].as_f64().unwrap() > 0.0);
 
     // Glass: refraction rays appear.
     let s = stats("glass_teapot.ron", &[]);

@@ -38,6 +38,8 @@ pub struct KernelStats {
     pub box_tests: u64,
     /// Newton jumps of the subdivision kernel that landed (`subdivision::jump`).
     pub jumps: u64,
+    /// Sub-patches a jump proved the ray does not cross, dropped without a split.
+    pub jump_drops: u64,
     /// The Toth kernel's own counters (LG90 Tables 2–6 rows).
     pub toth: toth::TothStats,
     /// The cached kernel's cache counters (LG90 Tables 2–6 rows).
@@ -50,6 +52,7 @@ impl KernelStats {
         self.splits += other.splits;
         self.box_tests += other.box_tests;
         self.jumps += other.jumps;
+        self.jump_drops += other.jump_drops;
         self.toth.add(&other.toth);
         self.cached.add(&other.cached);
     }

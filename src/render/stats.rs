@@ -72,6 +72,8 @@ pub struct RayTally {
     surface_tests: Tally,
     patch_tests: Tally,
     splits: Tally,
+    jumps: Tally,
+    jump_drops: Tally,
     box_tests: Tally,
     nodes: Tally,
     voxels: Tally,
@@ -85,6 +87,8 @@ impl RayTally {
         self.surface_tests.push(q.surface_tests);
         self.patch_tests.push(q.kernel.patch_tests);
         self.splits.push(q.kernel.splits);
+        self.jumps.push(q.kernel.jumps);
+        self.jump_drops.push(q.kernel.jump_drops);
         self.box_tests.push(q.kernel.box_tests + q.bvh_box_tests);
         self.nodes.push(q.nodes_visited);
         self.voxels.push(q.voxels_visited);
@@ -99,6 +103,8 @@ impl RayTally {
         self.surface_tests.merge(&o.surface_tests);
         self.patch_tests.merge(&o.patch_tests);
         self.splits.merge(&o.splits);
+        self.jumps.merge(&o.jumps);
+        self.jump_drops.merge(&o.jump_drops);
         self.box_tests.merge(&o.box_tests);
         self.nodes.merge(&o.nodes);
         self.voxels.merge(&o.voxels);
@@ -131,6 +137,8 @@ impl RayTally {
             surfaces_tested_per_ray: self.surface_tests.spread(n),
             patch_tests_per_ray: self.patch_tests.spread(n),
             splits_per_ray: self.splits.spread(n),
+            jumps_per_ray: self.jumps.spread(n),
+            jump_drops_per_ray: self.jump_drops.spread(n),
             box_tests_per_ray: self.box_tests.spread(n),
             bvh_nodes_per_ray: self.nodes.spread(n),
             voxels_per_ray: self.voxels.spread(n),
@@ -162,6 +170,10 @@ pub struct RayReport {
     /// reached BVH leaf, and triangle packs.
     pub patch_tests_per_ray: Spread,
     pub splits_per_ray: Spread,
+    /// Newton jumps of the subdivision kernel (primary rays in ray space only).
+    pub jumps_per_ray: Spread,
+    /// Sub-patches a jump proved the ray misses, dropped without splitting.
+    pub jump_drops_per_ray: Spread,
     pub box_tests_per_ray: Spread,
     pub bvh_nodes_per_ray: Spread,
     /// Grid voxels stepped through (`--accel grid`; 0 with the BVH).

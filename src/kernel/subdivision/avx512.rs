@@ -30,7 +30,7 @@ use super::bicubic::Net;
 use super::config::Termination;
 use super::float::{GBox, GRay, KernelFloat};
 use super::heuristics::Corners;
-use super::jump::{Jump, Linearization, plan};
+use super::jump::{Jump, JumpOutcome, Linearization, plan};
 use super::param::{ParamCell, Split};
 use super::ray_space::{MIN_RAY_SPACE_SCALE, RayFrame};
 use super::register::{ChildTests, Query, RegisterNet, RegisterStack, Scratch};
@@ -158,6 +158,10 @@ impl Net16 {
         );
         let rows = add(add(r[0], r[3]), mul(splat(3.0), add(r[1], r[2])));
         let centre = mul(hsum(mul(rows, half)), splat(1.0 / 64.0));
+        let magnitude = hmax(_mm512_max_ps(
+            _mm512_max_ps(abs(r[0]), abs(r[1])),
+            _mm512_max_ps(abs(r[2]), abs(r[3])),
+        ));
         // Across the registers: 3 (r[k+1] - r[k]), mean 3 Σ (r[3] - r[0]) / 12.
         let across: [__m512; 3] = std::array::from_fn(|k| mul(splat(3.0), sub(r[k + 1], r[k])));
         let across_mean = mul(hsum(sub(r[3], r[0])), splat(0.25));
@@ -202,8 +206,10 @@ impl Net16 {
         } else {
             (along, across)
         };
+        let [mx, my] = xy(magnitude);
         Linearization {
             centre: xy(centre),
+            magnitude: mx.max(my),
             du,
             dv,
             du_dev,
@@ -470,18 +476,22 @@ impl RegisterNet for Net16 {
         cell: ParamCell,
         ray: &Ray16,
         tmax: f32,
-    ) -> Option<(Net16, ParamCell, GBox<f32>, f32)> {
+    ) -> JumpOutcome<(Net16, ParamCell, GBox<f32>, f32)> {
         let Ray16::Axis { bounds, tmin } = *ray else {
-            return None;
+            return JumpOutcome::Undecided;
         };
         let (lu, lv) = cell.levels();
         // SAFETY: a Net16 exists only where AVX-512 is available (see `ray_registers`).
         unsafe {
-            let jump = plan(&self.linearization(), [lu, lv].map(|l| f32::MAX_LEVEL - l))?;
-            let net = self.descend(&jump);
-            let b = by_bound(boxes(&net.regs, &net.regs));
-            let [(bbox, t), _] = axis_pair(b, bounds, tmin, tmax);
-            Some((net, jump.cell(cell), bbox, t?))
+            let max_levels = [lu, lv].map(|l| f32::MAX_LEVEL - l);
+            plan(&self.linearization(), max_levels).and_then(|jump| {
+                let net = self.descend(&jump);
+                let b = by_bound(boxes(&net.regs, &net.regs));
+                match axis_pair(b, bounds, tmin, tmax) {
+                    [(bbox, Some(t)), _] => JumpOutcome::Landed((net, jump.cell(cell), bbox, t)),
+                    _ => JumpOutcome::Empty,
+                }
+            })
         }
     }
 
@@ -746,6 +756,8 @@ mod tests {
                     );
                 }
             }
+            // A maximum of the same floats: exact.
+            assert_eq!(got.magnitude, want.magnitude, "transposed {transposed}");
         }
     }
 

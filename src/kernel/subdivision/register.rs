@@ -17,6 +17,7 @@ use glam::{Mat4, Vec3A, Vec4};
 
 use super::float::{GBox, GRay};
 use super::heuristics::Corners;
+use super::jump::JumpOutcome;
 use super::param::{ParamCell, Split};
 use super::search::{NetStack, Node, SearchHit, search};
 use crate::geom::bbox::slab;
@@ -40,16 +41,16 @@ pub trait RegisterNet: Copy {
     -> (Self, ChildTests);
     /// Corner points `b(0,0)`, `b(n,0)`, `b(0,m)` for the split heuristics.
     fn corners(&self) -> Corners<f32>;
-    /// The jump of [`super::jump`] from this net, whose cell is `cell`: the sub-cell's net,
-    /// cell, box and entry `t` (clipped to `tmax`), if the jump applies and the ray hits
-    /// the sub-cell's box. Only nets in ray space can jump.
+    /// The jump of [`super::jump`] from this net, whose cell is `cell`: where it lands,
+    /// the sub-cell's net, cell, box and entry `t` (clipped to `tmax`). Only nets in ray
+    /// space can jump.
     fn jump(
         &self,
         _cell: ParamCell,
         _ray: &Self::RayRegisters,
         _tmax: f32,
-    ) -> Option<(Self, ParamCell, GBox<f32>, f32)> {
-        None
+    ) -> JumpOutcome<(Self, ParamCell, GBox<f32>, f32)> {
+        JumpOutcome::Undecided
     }
 }
 
@@ -206,12 +207,13 @@ impl<N: RegisterNet> NetStack<f32> for RegisterStack<'_, N> {
     }
 
     #[inline(always)]
-    fn try_jump(&mut self, cell: ParamCell, tmax: f32) -> Option<(ParamCell, GBox<f32>, f32)> {
-        let (net, sub, bbox, t) = self.cur.jump(cell, &self.ray, tmax)?;
-        // The current net stays as the fallback, pushed like a farther child.
-        self.pending = net;
-        self.push_far(true);
-        Some((sub, bbox, t))
+    fn try_jump(&mut self, cell: ParamCell, tmax: f32) -> JumpOutcome<(ParamCell, GBox<f32>, f32)> {
+        self.cur
+            .jump(cell, &self.ray, tmax)
+            .and_then(|(net, sub, bbox, t)| {
+                self.cur = net;
+                JumpOutcome::Landed((sub, bbox, t))
+            })
     }
 
     fn end_game_floor(&self) -> f32 {

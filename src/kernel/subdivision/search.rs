@@ -11,8 +11,8 @@
 //! Where the net storage can ([`NetStack::try_jump`], the ray-space bicubic net), a node
 //! from [`JUMP_FROM_LEVEL`] levels on first tries a Newton jump ([`super::jump`]): when
 //! the sub-patch is linear enough for the crossing to be unique and located, the search
-//! goes straight to the dyadic sub-cell holding it, and the node stays on the stack as a
-//! fallback that is searched only if that sub-cell yields no hit.
+//! goes straight to the dyadic sub-cell holding the crossing, or drops the node where the
+//! jump proves that the ray does not cross its sub-patch.
 //!
 //! Two rules keep the work bounded. A ray at a small angle θ to the surface hits about 1/θ
 //! boxes on every level along the stretch where it runs close to the surface, and the
@@ -40,6 +40,7 @@ use super::config::{
 };
 use super::float::{GBox, GRay, KernelFloat};
 use super::heuristics::{Corners, choose};
+use super::jump::JumpOutcome;
 use super::param::{ParamCell, Split};
 use crate::kernel::KernelStats;
 
@@ -59,13 +60,12 @@ pub trait NetStack<T: KernelFloat> {
     fn keep(&mut self, lower: bool);
     /// Drop the current net and continue with the most recently pushed one.
     fn pop(&mut self);
-    /// A jump ([`super::jump`]) from the current net, whose cell is `cell`: if the jumped-to
-    /// sub-cell's box is hit (entry `t` clipped to `tmax`), the current net is pushed (the
-    /// fallback), the sub-cell's net becomes current, and its cell, box and entry are
-    /// returned. `None` (nothing changed) where the storage has no jumps or the jump does
-    /// not apply.
-    fn try_jump(&mut self, _cell: ParamCell, _tmax: T) -> Option<(ParamCell, GBox<T>, T)> {
-        None
+    /// A jump ([`super::jump`]) from the current net, whose cell is `cell`: where it lands,
+    /// the sub-cell's net becomes current and its cell, box and entry `t` (clipped to
+    /// `tmax`) are returned. Nothing changes otherwise; [`JumpOutcome::Undecided`] where
+    /// the storage has no jumps.
+    fn try_jump(&mut self, _cell: ParamCell, _tmax: T) -> JumpOutcome<(ParamCell, GBox<T>, T)> {
+        JumpOutcome::Undecided
     }
     /// An L1 diameter below which boxes are rounding noise of the net the stack's nets
     /// came from (a net transformed into another frame is no more precise than its
@@ -82,24 +82,19 @@ pub struct Node<T> {
     pub t_enter: T,
     pub cell: ParamCell,
     is_final: bool,
-    /// For the fallback of a jump, the number of hits the search had found when it was
-    /// pushed: it is searched only if the jump found none. [`NOT_A_FALLBACK`] otherwise.
-    fallback_after: u32,
     /// The level (u + v) from which this node and its descendants try jumps: raised after
     /// a jump that does not apply, so that the next few levels do not pay for it again.
     jump_from: u8,
 }
 
-/// [`Node::fallback_after`] of a node searched like any other.
-const NOT_A_FALLBACK: u32 = u32::MAX;
-
 /// Jumps are tried from this many levels (u + v) on: on coarser cells the teapot's
 /// sub-patches are rarely linear enough for a jump, and the refused tries cost more than
-/// they save (measured from 6 to 14 levels, BENCHMARKS.md, issue 3).
-const JUMP_FROM_LEVEL: u8 = 12;
+/// they save (measured from 2 to 14 levels, BENCHMARKS.md, issue 3).
+const JUMP_FROM_LEVEL: u8 = 6;
 
-/// Levels (u + v) below a node whose jump did not apply before its descendants try again.
-const JUMP_RETRY_LEVELS: u8 = 2;
+/// Levels (u + v) below a node whose jump did not apply before its descendants try again
+/// (measured from 1 to 4, BENCHMARKS.md).
+const JUMP_RETRY_LEVELS: u8 = 1;
 
 /// A final box hit by the ray.
 #[derive(Clone, Copy, Debug)]
@@ -133,22 +128,18 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
         t_enter,
         cell: ParamCell::ROOT,
         is_final: false,
-        fallback_after: NOT_A_FALLBACK,
         jump_from: JUMP_FROM_LEVEL,
     };
-    let mut hits_found = 0u32;
     let mut best: Option<SearchHit<T>> = None;
     let max = T::MAX_LEVEL;
     let stop = Stop::new(cfg, &root, ray, rational, nets.end_game_floor());
     let (mut splits, mut doublings) = (0u32, 0u32);
     // The coarsened end game: boxes with an L1 diameter up to this are final.
     let mut coarse = -T::INFINITY;
-    loop {
+    'search: loop {
         // A popped entry was tested against an older, longer ray; after a hit only boxes
         // entered more than the hit box's extent before it matter (`tmax` is that bound).
-        let live = cur.t_enter <= tmax
-            && (best.is_none() || cur.t_enter < tmax)
-            && (cur.fallback_after == NOT_A_FALLBACK || cur.fallback_after == hits_found);
+        let live = cur.t_enter <= tmax && (best.is_none() || cur.t_enter < tmax);
         // A coarsened box is final only if the ray starts outside it (so a secondary ray
         // cannot take the coarse box around its own origin for a hit), until the last
         // doubling, after which every box is.
@@ -162,7 +153,6 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
                 bbox: cur.bbox,
             });
             tmax = cur.t_enter - stop.extent_along_ray(&cur.bbox);
-            hits_found += 1;
             if any_hit {
                 return best;
             }
@@ -182,63 +172,67 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
                     continue;
                 }
             }
-            let (lu, lv) = cur.cell.levels();
-            if lu + lv >= cur.jump_from && cur.fallback_after == NOT_A_FALLBACK {
-                if let Some((cell, bbox, t)) = nets.try_jump(cur.cell, tmax) {
-                    stats.jumps += 1;
-                    stats.box_tests += 1;
-                    nodes.push(Node {
-                        fallback_after: hits_found,
-                        ..cur
-                    });
-                    cur = stop.child(bbox, cell, cur.bbox.l1_diameter(), t, 0);
-                    continue;
-                }
-                cur.jump_from = lu + lv + JUMP_RETRY_LEVELS;
-            }
-            splits += 1;
-            let dir = if lu >= max {
-                Split::V
-            } else if lv >= max {
-                Split::U
-            } else {
-                choose(cfg.heuristic, &nets.corners(), ray.dir)
-            };
-            stats.splits += 1;
-            stats.box_tests += 2;
-            let [(box0, hit0), (box1, hit1)] = nets.split_test(dir, ray, tmax);
-            let boxes = [box0, box1];
-            let cells = cur.cell.split(dir);
-            let d = cur.bbox.l1_diameter();
-            // Children are built by an always-inlined method, not a closure: the compiler
-            // stopped inlining the closure when the search grew, and the call spilled every
-            // vector register (a quarter of the bicubic search's time).
-            let lower = |t| stop.child(boxes[0], cells.0, d, t, cur.jump_from);
-            let upper = |t| stop.child(boxes[1], cells.1, d, t, cur.jump_from);
-            match (hit0, hit1) {
-                (Some(t0), Some(t1)) => {
-                    let far_is_lower = t1 < t0;
-                    nets.push_far(far_is_lower);
-                    if far_is_lower {
-                        nodes.push(lower(t0));
-                        cur = upper(t1);
-                    } else {
-                        nodes.push(upper(t1));
-                        cur = lower(t0);
+            'split: {
+                let (lu, lv) = cur.cell.levels();
+                if lu + lv >= cur.jump_from {
+                    match nets.try_jump(cur.cell, tmax) {
+                        JumpOutcome::Landed((cell, bbox, t)) => {
+                            stats.jumps += 1;
+                            stats.box_tests += 1;
+                            cur = stop.child(bbox, cell, cur.bbox.l1_diameter(), t, 0);
+                            continue 'search;
+                        }
+                        JumpOutcome::Empty => {
+                            stats.jump_drops += 1;
+                            break 'split;
+                        }
+                        JumpOutcome::Undecided => cur.jump_from = lu + lv + JUMP_RETRY_LEVELS,
                     }
-                    continue;
                 }
-                (Some(t0), None) => {
-                    nets.keep(true);
-                    cur = lower(t0);
-                    continue;
+                splits += 1;
+                let dir = if lu >= max {
+                    Split::V
+                } else if lv >= max {
+                    Split::U
+                } else {
+                    choose(cfg.heuristic, &nets.corners(), ray.dir)
+                };
+                stats.splits += 1;
+                stats.box_tests += 2;
+                let [(box0, hit0), (box1, hit1)] = nets.split_test(dir, ray, tmax);
+                let boxes = [box0, box1];
+                let cells = cur.cell.split(dir);
+                let d = cur.bbox.l1_diameter();
+                // Children are built by an always-inlined method, not a closure: the compiler
+                // stopped inlining the closure when the search grew, and the call spilled every
+                // vector register (a quarter of the bicubic search's time).
+                let lower = |t| stop.child(boxes[0], cells.0, d, t, cur.jump_from);
+                let upper = |t| stop.child(boxes[1], cells.1, d, t, cur.jump_from);
+                match (hit0, hit1) {
+                    (Some(t0), Some(t1)) => {
+                        let far_is_lower = t1 < t0;
+                        nets.push_far(far_is_lower);
+                        if far_is_lower {
+                            nodes.push(lower(t0));
+                            cur = upper(t1);
+                        } else {
+                            nodes.push(upper(t1));
+                            cur = lower(t0);
+                        }
+                        continue 'search;
+                    }
+                    (Some(t0), None) => {
+                        nets.keep(true);
+                        cur = lower(t0);
+                        continue 'search;
+                    }
+                    (None, Some(t1)) => {
+                        nets.keep(false);
+                        cur = upper(t1);
+                        continue 'search;
+                    }
+                    (None, None) => {}
                 }
-                (None, Some(t1)) => {
-                    nets.keep(false);
-                    cur = upper(t1);
-                    continue;
-                }
-                (None, None) => {}
             }
         }
         match nodes.pop() {
@@ -357,7 +351,6 @@ impl<T: KernelFloat> Stop<T> {
             t_enter,
             cell,
             is_final: self.is_final(&bbox, parent_diameter, cell, t_enter),
-            fallback_after: NOT_A_FALLBACK,
             jump_from,
         }
     }
