@@ -178,32 +178,39 @@ pub fn plan(lin: &Linearization, max_levels: [u8; 2]) -> JumpOutcome<Jump> {
         f(lin.du_dev),
         f(lin.dv_dev),
     );
-    // J₀ = [du dv] (columns), its inverse by the adjugate.
+    // J₀ = [du dv] (columns), J₀⁻¹ = A / det with A the adjugate. The plan is written in
+    // terms of A with three independent divisions and one more for 1 / (1 − q), as the
+    // search waits for it (nine divisions in a chain of three measured slower,
+    // BENCHMARKS.md).
     let det = du[0] * dv[1] - dv[0] * du[1];
     if !det.is_normal() {
         return JumpOutcome::Undecided;
     }
-    let inv = [[dv[1] / det, -dv[0] / det], [-du[1] / det, du[0] / det]];
-    let abs_inv = inv.map(|row| row.map(f64::abs));
-    // The weights of the norm (module documentation).
-    let w = abs_inv.map(|row| row[0] + row[1]);
+    let adj = [[dv[1], -dv[0]], [-du[1], du[0]]];
+    let abs_adj = adj.map(|row| row.map(f64::abs));
+    // The weights of the norm (module documentation) times |det|.
+    let a = abs_adj.map(|row| row[0] + row[1]);
+    let (inv_det, inv_a) = (1.0 / det.abs(), [1.0 / a[0], 1.0 / a[1]]);
     // The Lipschitz bound q = ‖W⁻¹ |J₀⁻¹| E W‖∞ with E = [eu ev] (columns).
-    let m = abs_inv.map(|row| {
+    let m = abs_adj.map(|row| {
         [
             row[0] * eu[0] + row[1] * eu[1],
             row[0] * ev[0] + row[1] * ev[1],
         ]
     });
     let q = (0..2)
-        .map(|r| (m[r][0] * w[0] + m[r][1] * w[1]) / w[r])
+        .map(|r| (m[r][0] * a[0] + m[r][1] * a[1]) * inv_a[r] * inv_det)
         .fold(0f64, f64::max);
     if q.is_nan() || q >= MAX_CONTRACTION {
         return JumpOutcome::Undecided;
     }
-    let step = [0, 1].map(|r| inv[r][0] * c[0] + inv[r][1] * c[1]);
-    let step_norm = (step[0] / w[0]).abs().max((step[1] / w[1]).abs());
+    // The simplified Newton step J₀⁻¹ F(c), and its norm (where det cancels).
+    let adj_c = [0, 1].map(|r| adj[r][0] * c[0] + adj[r][1] * c[1]);
+    let step = adj_c.map(|x| x * inv_det.copysign(det));
+    let step_norm = (adj_c[0] * inv_a[0]).abs().max((adj_c[1] * inv_a[1]).abs());
     let rounding = ROUNDING_ULPS * f64::from(f32::EPSILON) * f64::from(lin.magnitude);
     let radius = (q * step_norm + rounding) / (1.0 - q);
+    let w = a.map(|x| x * inv_det);
     let mut levels = [0u8; 2];
     let mut index = [0u64; 2];
     for d in 0..2 {
