@@ -30,7 +30,7 @@ use super::bicubic::Net;
 use super::config::Termination;
 use super::float::{GBox, GRay, KernelFloat};
 use super::heuristics::Corners;
-use super::jump::{Jump, JumpOutcome, Linearization, plan};
+use super::jump::{Jump, JumpOutcome, Linearization, plan, restriction};
 use super::param::{ParamCell, Split};
 use super::ray_space::{MIN_RAY_SPACE_SCALE, RayFrame};
 use super::register::{ChildTests, Query, RegisterNet, RegisterStack, Scratch};
@@ -217,10 +217,11 @@ impl Net16 {
         }
     }
 
-    /// The sub-net of a jump: halvings towards the jumped-to cell, each choosing its half
-    /// by the index bit, with no box or test. The halvings are the search's own
-    /// ([`split4`]), the direction the registers run across first, so at most one
-    /// transpose.
+    /// The sub-net of a jump, with no box or test, the direction the registers run across
+    /// first, so at most one transpose. Where the window lies inside the cell, one product
+    /// with the [`restriction`] matrix per direction; elsewhere the search's own halvings
+    /// ([`split4`]) towards the jumped-to cell, each choosing its half by the index bit, so
+    /// that the sub-net's border is the one a neighbour made by halving has.
     #[target_feature(enable = "avx512f")]
     fn descend(&self, jump: &Jump) -> Net16 {
         let mut net = *self;
@@ -239,6 +240,18 @@ impl Net16 {
             if (dir == Split::V) == net.transposed {
                 net.regs = transpose(net.regs);
                 net.transposed = !net.transposed;
+            }
+            if jump.interior {
+                let m = restriction(levels, jump.index[d]);
+                let r = net.regs;
+                net.regs = m.map(|w| {
+                    let term = |j: usize| _mm512_mul_ps(_mm512_set1_ps(w[j]), r[j]);
+                    _mm512_add_ps(
+                        _mm512_add_ps(term(0), term(1)),
+                        _mm512_add_ps(term(2), term(3)),
+                    )
+                });
+                continue;
             }
             for level in (0..levels).rev() {
                 let (lo, hi) = split4(net.regs);
@@ -709,11 +722,16 @@ mod tests {
     /// The point `(i, j)`'s (x, y) of a net, read lane by lane (the layout of the module
     /// documentation), for the scalar reference.
     fn points_xy(net: &Net16) -> [[[f32; 2]; 4]; 4] {
+        points(net).map(|row| row.map(|p| [p[0], p[1]]))
+    }
+
+    /// The point `(i, j)` of a net at `[j][i]`, read lane by lane.
+    fn points(net: &Net16) -> [[[f32; 3]; 4]; 4] {
         let regs = net.regs.map(Net16::lanes);
         std::array::from_fn(|j| {
             std::array::from_fn(|i| {
                 let (r, lane) = if net.transposed { (i, j) } else { (j, i) };
-                [regs[r][lane], regs[r][4 + lane]]
+                [regs[r][lane], regs[r][4 + lane], regs[r][8 + lane]]
             })
         })
     }
@@ -772,7 +790,11 @@ mod tests {
         let root = unsafe { Net16::from_net(&Net::from_patch(&patch())) };
         let ray = Net16::ray_registers(&rays()[0]);
         for (levels, index) in [([3, 2], [5, 1]), ([0, 4], [0, 9]), ([6, 0], [37, 0])] {
-            let jump = Jump { levels, index };
+            let jump = Jump {
+                levels,
+                index,
+                interior: false,
+            };
             // SAFETY: as above.
             let got = unsafe { root.descend(&jump) };
             let mut want = root;
@@ -788,6 +810,87 @@ mod tests {
             assert_eq!(got.transposed, want.transposed, "{jump:?}");
             let bits = |n: &Net16| n.regs.map(|r| Net16::lanes(r).map(f32::to_bits));
             assert_eq!(bits(&got), bits(&want), "{jump:?}");
+        }
+    }
+
+    /// One halving of a cubic's control values in `f64` (de Casteljau at 1/2), the lower
+    /// or the upper half.
+    fn halve(c: [f64; 4], upper: bool) -> [f64; 4] {
+        let m = |a: f64, b: f64| 0.5 * (a + b);
+        let (c01, c12, c23) = (m(c[0], c[1]), m(c[1], c[2]), m(c[2], c[3]));
+        let (c012, c123) = (m(c01, c12), m(c12, c23));
+        let mid = m(c012, c123);
+        if upper {
+            [mid, c123, c23, c[3]]
+        } else {
+            [c[0], c01, c012, mid]
+        }
+    }
+
+    /// A jump's descent where the window lies inside the cell (the [`restriction`]
+    /// matrices) is the net of the jumped-to sub-cell: against halvings in `f64`, an
+    /// independent computation, within a few ulps of the net's largest coordinate (the
+    /// rounding [`super::super::jump`] allows it).
+    #[test]
+    fn interior_descent_is_the_sub_net_of_the_cell() {
+        if !available() {
+            return;
+        }
+        // SAFETY: AVX-512F is available (checked above).
+        let root = unsafe { Net16::from_net(&Net::from_patch(&patch())) };
+        let exact = points(&root).map(|row| row.map(|p| p.map(f64::from)));
+        let scale = exact
+            .iter()
+            .flatten()
+            .flatten()
+            .fold(0f64, |m, c| m.max(c.abs()));
+        let jumps = [
+            ([3, 2], [5, 1]),
+            ([0, 4], [0, 9]),
+            ([6, 0], [37, 0]),
+            ([12, 9], [1234, 300]),
+            ([21, 17], [654_321, 77_777]),
+        ];
+        for (levels, index) in jumps {
+            let jump = Jump {
+                levels,
+                index,
+                interior: true,
+            };
+            // SAFETY: as above.
+            let got = points(&unsafe { root.descend(&jump) });
+            let mut want = exact;
+            for level in (0..levels[0]).rev() {
+                let upper = (index[0] >> level) & 1 == 1;
+                for row in want.iter_mut() {
+                    for c in 0..3 {
+                        let h = halve(row.map(|p| p[c]), upper);
+                        for (p, v) in row.iter_mut().zip(h) {
+                            p[c] = v;
+                        }
+                    }
+                }
+            }
+            for level in (0..levels[1]).rev() {
+                let upper = (index[1] >> level) & 1 == 1;
+                for i in 0..4 {
+                    for c in 0..3 {
+                        let h = halve(std::array::from_fn(|j| want[j][i][c]), upper);
+                        for (j, v) in h.into_iter().enumerate() {
+                            want[j][i][c] = v;
+                        }
+                    }
+                }
+            }
+            let tolerance = 8.0 * scale * f64::from(f32::EPSILON);
+            for (g, w) in got.iter().flatten().zip(want.iter().flatten()) {
+                for c in 0..3 {
+                    assert!(
+                        (f64::from(g[c]) - w[c]).abs() <= tolerance,
+                        "{jump:?}: {g:?} vs {w:?}"
+                    );
+                }
+            }
         }
     }
 }

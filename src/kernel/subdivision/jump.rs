@@ -54,9 +54,11 @@ use super::param::ParamCell;
 const MAX_CONTRACTION: f64 = 0.5;
 
 /// Ulps of the net's largest `|x|`, `|y|` within which a point counts as a crossing, `η`
-/// of the module documentation: the centre point is a sum of 16 products, rounded by at
-/// most a few ulps of that magnitude.
-const ROUNDING_ULPS: f64 = 16.0;
+/// of the module documentation: more than the rounding of the `f32` centre point (a sum
+/// of 16 products) and of a sub-net made by [`restriction`] (two matrix products of
+/// rounded weights, about 8 ulps), each a few ulps of that magnitude. The jumps' counts on
+/// the teapot are the same from 4 to 128 (BENCHMARKS.md, issue 3).
+const ROUNDING_ULPS: f64 = 32.0;
 
 /// A jump is taken from this many levels on, in both directions together. Once the plan is
 /// made, even one level of descent and a box test cost less than the split they replace
@@ -108,6 +110,9 @@ impl<L> JumpOutcome<L> {
 pub struct Jump {
     pub levels: [u8; 2],
     pub index: [u64; 2],
+    /// Whether the window lies inside the cell, away from its border: then the sub-net may
+    /// be computed by [`restriction`] (see there).
+    pub interior: bool,
 }
 
 impl Jump {
@@ -115,6 +120,46 @@ impl Jump {
     pub fn cell(&self, cell: ParamCell) -> ParamCell {
         cell.sub_cell(self.levels, self.index)
     }
+}
+
+/// The matrix taking a cubic Bézier curve's control points over `[0, 1]` to those of its
+/// piece over the dyadic interval `[a, b]`, `a = index 2^-levels`, `b = a + 2^-levels`: row
+/// `i` holds the weights of new point `i`, the cubic Bernstein polynomials' blossoms at
+/// `(a, a, a)`, `(a, a, b)`, `(a, b, b)` and `(b, b, b)` (Farin, *Curves and Surfaces for
+/// CAGD*, §4.2 and §5.5). Computed in `f64` and rounded once.
+///
+/// Why it may replace the halvings: the weights are non-negative and sum to 1, so the new
+/// points are convex combinations, rounded by a few ulps of the net's largest coordinate,
+/// as the halvings' points are, but in one matrix product instead of one dependent
+/// de Casteljau step per level. Their roundings differ from the halvings', so a sub-net
+/// made this way does not share its border bit for bit with a neighbour made by halving,
+/// which Dammertz §2.3.3's crack freedom needs. A window inside the cell makes that moot:
+/// every point of the cell with `‖F‖∞ ≤ η` lies in the window (module documentation), so
+/// on the sub-cell's border the surface stays more than `η` from the ray, farther than
+/// either net's rounding can move it ([`ROUNDING_ULPS`]), and the search never needs the
+/// sub-cell's neighbours.
+pub fn restriction(levels: u8, index: u64) -> [[f32; 4]; 4] {
+    let width = (-f64::from(levels)).exp2();
+    let a = index as f64 * width;
+    let b = a + width;
+    let (s, t) = (1.0 - a, 1.0 - b);
+    [
+        [s * s * s, 3.0 * a * s * s, 3.0 * a * a * s, a * a * a],
+        [
+            s * s * t,
+            2.0 * a * s * t + s * s * b,
+            a * a * t + 2.0 * a * s * b,
+            a * a * b,
+        ],
+        [
+            s * t * t,
+            a * t * t + 2.0 * s * b * t,
+            2.0 * a * b * t + s * b * b,
+            a * b * b,
+        ],
+        [t * t * t, 3.0 * b * t * t, 3.0 * b * b * t, b * b * b],
+    ]
+    .map(|row| row.map(|w| w as f32))
 }
 
 /// A bicubic net's linearisation from its points' (x, y), `xy[j][i]` the point `(i, j)`
@@ -213,12 +258,14 @@ pub fn plan(lin: &Linearization, max_levels: [u8; 2]) -> JumpOutcome<Jump> {
     let w = a.map(|x| x * inv_det);
     let mut levels = [0u8; 2];
     let mut index = [0u64; 2];
+    let mut interior = true;
     for d in 0..2 {
         let (centre, half_width) = (0.5 - step[d], w[d] * radius);
         let (lo, hi) = (centre - half_width, centre + half_width);
         if !(hi >= 0.0 && lo <= 1.0) {
             return JumpOutcome::Empty;
         }
+        interior &= lo > 0.0 && hi < 1.0;
         let k = max_levels[d];
         let scale = (1u64 << k) as f64;
         let top = (1u64 << k) - 1;
@@ -232,7 +279,11 @@ pub fn plan(lin: &Linearization, max_levels: [u8; 2]) -> JumpOutcome<Jump> {
         index[d] = a >> drop;
     }
     if levels[0] + levels[1] >= MIN_JUMP_LEVELS {
-        JumpOutcome::Landed(Jump { levels, index })
+        JumpOutcome::Landed(Jump {
+            levels,
+            index,
+            interior,
+        })
     } else {
         JumpOutcome::Undecided
     }
@@ -383,5 +434,44 @@ mod tests {
             jumped > 500 && dropped > 200 && refused > 200,
             "{jumped} jumps, {dropped} dropped, {refused} refused"
         );
+    }
+
+    /// The restriction matrices against the piece's control points by halvings in `f64`:
+    /// an independent computation of the same sub-curve.
+    #[test]
+    fn restriction_is_repeated_halving() {
+        let curve = [0.3, -1.7, 2.25, 0.9];
+        for (levels, index) in [(0, 0), (1, 1), (3, 5), (10, 700), (24, 12_345_678)] {
+            let m = restriction(levels, index);
+            let mut want = curve;
+            for level in (0..levels).rev() {
+                let upper = (index >> level) & 1 == 1;
+                let mid = |a: f64, b: f64| 0.5 * (a + b);
+                let (c01, c12, c23) = (
+                    mid(want[0], want[1]),
+                    mid(want[1], want[2]),
+                    mid(want[2], want[3]),
+                );
+                let (c012, c123) = (mid(c01, c12), mid(c12, c23));
+                let c = mid(c012, c123);
+                want = if upper {
+                    [c, c123, c23, want[3]]
+                } else {
+                    [want[0], c01, c012, c]
+                };
+            }
+            for (row, w) in m.iter().zip(want) {
+                let got: f64 = row.iter().zip(curve).map(|(&a, b)| f64::from(a) * b).sum();
+                // The weights are rounded to f32: a few ulps of the largest control value.
+                assert!(
+                    (got - w).abs() <= 4.0 * 2.25 * f64::from(f32::EPSILON),
+                    "{levels} {index}: {got} vs {w}"
+                );
+                // Convex combinations: non-negative weights summing to 1.
+                assert!(row.iter().all(|&a| a >= 0.0));
+                let sum: f64 = row.iter().map(|&a| f64::from(a)).sum();
+                assert!((sum - 1.0).abs() <= 4.0 * f64::from(f32::EPSILON));
+            }
+        }
     }
 }
