@@ -596,6 +596,7 @@ mod tests {
     use super::*;
     use crate::kernel::subdivision::SubdivisionConfig;
     use crate::kernel::subdivision::bicubic::tests::patch;
+    use crate::kernel::subdivision::jump::halve;
     use crate::kernel::subdivision::register::{LaneNet, search_register};
 
     /// Random rays from above aimed at the patch's neighbourhood, by a fixed xorshift32.
@@ -810,20 +811,6 @@ mod tests {
             assert_eq!(got.transposed, want.transposed, "{jump:?}");
             let bits = |n: &Net16| n.regs.map(|r| Net16::lanes(r).map(f32::to_bits));
             assert_eq!(bits(&got), bits(&want), "{jump:?}");
-        }
-    }
-
-    /// One halving of a cubic's control values in `f64` (de Casteljau at 1/2), the lower
-    /// or the upper half.
-    fn halve(c: [f64; 4], upper: bool) -> [f64; 4] {
-        let m = |a: f64, b: f64| 0.5 * (a + b);
-        let (c01, c12, c23) = (m(c[0], c[1]), m(c[1], c[2]), m(c[2], c[3]));
-        let (c012, c123) = (m(c01, c12), m(c12, c23));
-        let mid = m(c012, c123);
-        if upper {
-            [mid, c123, c23, c[3]]
-        } else {
-            [c[0], c01, c012, mid]
         }
     }
 

@@ -289,6 +289,22 @@ pub fn plan(lin: &Linearization, max_levels: [u8; 2]) -> JumpOutcome<Jump> {
     }
 }
 
+/// One halving of a cubic's control values in `f64` (de Casteljau at 1/2), the lower or
+/// the upper half: the reference the restriction matrices and the descents are tested
+/// against.
+#[cfg(test)]
+pub fn halve(c: [f64; 4], upper: bool) -> [f64; 4] {
+    let mid = |a: f64, b: f64| 0.5 * (a + b);
+    let (c01, c12, c23) = (mid(c[0], c[1]), mid(c[1], c[2]), mid(c[2], c[3]));
+    let (c012, c123) = (mid(c01, c12), mid(c12, c23));
+    let centre = mid(c012, c123);
+    if upper {
+        [centre, c123, c23, c[3]]
+    } else {
+        [c[0], c01, c012, centre]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -445,20 +461,7 @@ mod tests {
             let m = restriction(levels, index);
             let mut want = curve;
             for level in (0..levels).rev() {
-                let upper = (index >> level) & 1 == 1;
-                let mid = |a: f64, b: f64| 0.5 * (a + b);
-                let (c01, c12, c23) = (
-                    mid(want[0], want[1]),
-                    mid(want[1], want[2]),
-                    mid(want[2], want[3]),
-                );
-                let (c012, c123) = (mid(c01, c12), mid(c12, c23));
-                let c = mid(c012, c123);
-                want = if upper {
-                    [c, c123, c23, want[3]]
-                } else {
-                    [want[0], c01, c012, c]
-                };
+                want = halve(want, (index >> level) & 1 == 1);
             }
             for (row, w) in m.iter().zip(want) {
                 let got: f64 = row.iter().zip(curve).map(|(&a, b)| f64::from(a) * b).sum();
