@@ -46,6 +46,7 @@ pub fn convert_scene(scene: &Scene) -> (Scene, ConversionReport) {
                     converted.push(Surface {
                         geometry: SurfaceGeometry::Bezier(p),
                         trims: s.trims,
+                        trim_space: s.trim_space,
                     });
                 }
                 SurfaceGeometry::Nurbs(n) => {

@@ -6,7 +6,7 @@ use glam::{DVec3, Vec3};
 use crate::geom::BezierPatch;
 use crate::geom::bbox::DAabb;
 use crate::geom::nurbs::NurbsSurface;
-use crate::geom::trim::TrimLoop;
+use crate::geom::trim::{AxisMap, TrimLoop};
 
 /// Camera per the DESIGN.md contract.
 #[derive(Clone, Debug, PartialEq)]
@@ -65,7 +65,12 @@ impl Material {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Surface {
     pub geometry: SurfaceGeometry,
+    /// Trim loops in the surface's parameter domain, as mapped by `trim_space`; none means
+    /// the whole domain.
     pub trims: Vec<TrimLoop>,
+    /// For (u, v): how the NURBS parameter maps to the parameter the loops are written in
+    /// (identity but for analytic surfaces read from CAD files).
+    pub trim_space: [AxisMap; 2],
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -79,6 +84,7 @@ impl Surface {
         Surface {
             geometry: SurfaceGeometry::Bezier(patch),
             trims: Vec::new(),
+            trim_space: Default::default(),
         }
     }
 

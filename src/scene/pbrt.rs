@@ -563,5 +563,6 @@ fn nurbs(p: &Parser, shape: &Tok, params: &[Param]) -> Result<Surface, ParseErro
     Ok(Surface {
         geometry: SurfaceGeometry::Nurbs(surface),
         trims: Vec::new(),
+        trim_space: Default::default(),
     })
 }

@@ -414,6 +414,7 @@ fn surface_from_def(d: &SurfaceDef) -> Result<Surface, crate::geom::GeomError> {
                 homogeneous(points, weights)?,
             )?),
             trims: Vec::new(),
+            trim_space: Default::default(),
         },
     })
 }

@@ -511,6 +511,7 @@ impl<'a> Reader<'a, '_> {
                 Ok(vec![Surface {
                     geometry: SurfaceGeometry::Nurbs(nurbs),
                     trims: block.trims,
+                    trim_space: Default::default(),
                 }])
             }
             Basis::Bezier => {
@@ -543,6 +544,7 @@ impl<'a> Reader<'a, '_> {
                         surfaces.push(Surface {
                             geometry: SurfaceGeometry::Bezier(patch),
                             trims: block.trims.clone(),
+                            trim_space: Default::default(),
                         });
                     }
                 }
