@@ -44,6 +44,9 @@ pub enum ShapeError {
 /// curves are written in.
 pub type MappedSurface = (NurbsSurface, [AxisMap; 2]);
 
+/// A parameter range `[start, end]`, `start < end`.
+pub type Span = [f64; 2];
+
 /// How far beyond 2π an angle range may reach and still be one turn: a few ulps of 2π,
 /// what `end − start` of two angles written in decimal may round to.
 const TURN_SLACK: f64 = 8.0 * f64::EPSILON * TAU;
@@ -177,8 +180,7 @@ pub fn ellipse_arc(
     frame: &Frame,
     a: f64,
     b: f64,
-    t0: f64,
-    t1: f64,
+    [t0, t1]: Span,
 ) -> Result<(NurbsCurve, AxisMap), ShapeError> {
     positive(a, "semi-axis a")?;
     positive(b, "semi-axis b")?;
@@ -206,7 +208,7 @@ pub fn circle_arc(
     a0: f64,
     a1: f64,
 ) -> Result<(NurbsCurve, AxisMap), ShapeError> {
-    ellipse_arc(frame, radius, radius, a0, a1)
+    ellipse_arc(frame, radius, radius, [a0, a1])
 }
 
 /// The hyperbola branch `origin + a cosh t · x + b sinh t · y`, t in `[t0, t1]`, as one
@@ -218,8 +220,7 @@ pub fn hyperbola_arc(
     frame: &Frame,
     a: f64,
     b: f64,
-    t0: f64,
-    t1: f64,
+    [t0, t1]: Span,
 ) -> Result<NurbsCurve, ShapeError> {
     positive(a, "semi-axis a")?;
     positive(b, "semi-axis b")?;
@@ -338,43 +339,26 @@ pub fn revolution(
 fn revolve_in_frame(
     frame: &Frame,
     profile: &NurbsCurve,
-    a0: f64,
-    a1: f64,
+    [a0, a1]: Span,
 ) -> Result<MappedSurface, ShapeError> {
     revolution(&in_frame(frame, profile), frame.origin, frame.z, a0, a1)
 }
 
-/// The cylinder `origin + r (cos u x + sin u y) + v z`, u in `[a0, a1]`, v in `[v0, v1]`
+/// The cylinder `origin + r (cos u x + sin u y) + v z`, u and v in their spans
 /// (ISO 10303-42 cylindrical_surface).
-pub fn cylinder(
-    frame: &Frame,
-    radius: f64,
-    a0: f64,
-    a1: f64,
-    v0: f64,
-    v1: f64,
-) -> Result<MappedSurface, ShapeError> {
+pub fn cylinder(frame: &Frame, radius: f64, u: Span, v: Span) -> Result<MappedSurface, ShapeError> {
     positive(radius, "radius")?;
-    let line = line_segment(
-        DVec3::new(radius, 0.0, v0),
-        DVec3::new(radius, 0.0, v1),
-        v0,
-        v1,
-    )?;
-    revolve_in_frame(frame, &line, a0, a1)
+    cone(frame, radius, 0.0, u, v)
 }
 
-/// The cone `origin + (r + v tan α)(cos u x + sin u y) + v z`, u in `[a0, a1]`, v in
-/// `[v0, v1]` (ISO 10303-42 conical_surface; `radius` is the radius at v = 0, `semi_angle`
+/// The cone `origin + (r + v tan α)(cos u x + sin u y) + v z`, u and v in their spans (ISO 10303-42 conical_surface; `radius` is the radius at v = 0, `semi_angle`
 /// the half angle α in radians, and r + v tan α may reach 0, the apex).
 pub fn cone(
     frame: &Frame,
     radius: f64,
     semi_angle: f64,
-    a0: f64,
-    a1: f64,
-    v0: f64,
-    v1: f64,
+    u: Span,
+    [v0, v1]: Span,
 ) -> Result<MappedSurface, ShapeError> {
     let t = semi_angle.tan();
     if !(radius >= 0.0 && t.is_finite()) {
@@ -389,53 +373,48 @@ pub fn cone(
         v0,
         v1,
     )?;
-    revolve_in_frame(frame, &line, a0, a1)
+    revolve_in_frame(frame, &line, u)
 }
 
-/// The sphere `origin + r cos v (cos u x + sin u y) + r sin v z`, u (longitude) in
-/// `[a0, a1]`, v (latitude) in `[v0, v1]` ⊂ [−π/2, π/2] (ISO 10303-42 spherical_surface).
-pub fn sphere(
-    frame: &Frame,
-    radius: f64,
-    a0: f64,
-    a1: f64,
-    v0: f64,
-    v1: f64,
-) -> Result<MappedSurface, ShapeError> {
+/// The sphere `origin + r cos v (cos u x + sin u y) + r sin v z`, u (longitude) and v
+/// (latitude, within [−π/2, π/2]) in their spans (ISO 10303-42 spherical_surface).
+pub fn sphere(frame: &Frame, radius: f64, u: Span, v: Span) -> Result<MappedSurface, ShapeError> {
     positive(radius, "radius")?;
+    tube_revolution(frame, 0.0, radius, u, v)
+}
+
+/// The torus `origin + (R + r cos v)(cos u x + sin u y) + r sin v z`, u and v in their spans
+/// (ISO 10303-42 toroidal_surface; `major` R, `minor` r).
+pub fn torus(
+    frame: &Frame,
+    major: f64,
+    minor: f64,
+    u: Span,
+    v: Span,
+) -> Result<MappedSurface, ShapeError> {
+    positive(major, "major radius")?;
+    positive(minor, "minor radius")?;
+    tube_revolution(frame, major, minor, u, v)
+}
+
+/// A circle of `radius` about (ρ, z) = (`centre`, 0) in the meridian half plane, from
+/// angle v0 to v1 (measured from the ρ axis towards z), revolved through the angles u: the torus,
+/// and for `centre` = 0 the sphere.
+fn tube_revolution(
+    frame: &Frame,
+    centre: f64,
+    radius: f64,
+    u: Span,
+    [v0, v1]: Span,
+) -> Result<MappedSurface, ShapeError> {
     let meridian = Frame {
-        origin: DVec3::ZERO,
+        origin: DVec3::new(centre, 0.0, 0.0),
         x: DVec3::X,
         y: DVec3::Z,
         z: -DVec3::Y,
     };
     let (arc, v_map) = circle_arc(&meridian, radius, v0, v1)?;
-    let (s, [u_map, _]) = revolve_in_frame(frame, &arc, a0, a1)?;
-    Ok((s, [u_map, v_map]))
-}
-
-/// The torus `origin + (R + r cos v)(cos u x + sin u y) + r sin v z`, u in `[a0, a1]`, v in
-/// `[v0, v1]` (ISO 10303-42 toroidal_surface; `major` R, `minor` r).
-#[allow(clippy::too_many_arguments)]
-pub fn torus(
-    frame: &Frame,
-    major: f64,
-    minor: f64,
-    a0: f64,
-    a1: f64,
-    v0: f64,
-    v1: f64,
-) -> Result<MappedSurface, ShapeError> {
-    positive(major, "major radius")?;
-    positive(minor, "minor radius")?;
-    let tube = Frame {
-        origin: DVec3::new(major, 0.0, 0.0),
-        x: DVec3::X,
-        y: DVec3::Z,
-        z: -DVec3::Y,
-    };
-    let (arc, v_map) = circle_arc(&tube, minor, v0, v1)?;
-    let (s, [u_map, _]) = revolve_in_frame(frame, &arc, a0, a1)?;
+    let (s, [u_map, _]) = revolve_in_frame(frame, &arc, u)?;
     Ok((s, [u_map, v_map]))
 }
 

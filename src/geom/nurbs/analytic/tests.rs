@@ -98,7 +98,7 @@ fn circle_arcs_of_any_range_are_exact_and_split_at_most_90_degrees() {
 #[test]
 fn ellipse_arc_is_the_affine_circle() {
     let f = tilted();
-    let (c, map) = ellipse_arc(&f, 3.0, 0.5, -0.7, 4.0).unwrap();
+    let (c, map) = ellipse_arc(&f, 3.0, 0.5, [-0.7, 4.0]).unwrap();
     check_curve(
         &c,
         &map,
@@ -110,7 +110,7 @@ fn ellipse_arc_is_the_affine_circle() {
 #[test]
 fn hyperbola_and_parabola_lie_on_their_conics() {
     let f = tilted();
-    let h = hyperbola_arc(&f, 2.0, 0.5, -1.2, 0.7).unwrap();
+    let h = hyperbola_arc(&f, 2.0, 0.5, [-1.2, 0.7]).unwrap();
     for k in 0..=20 {
         let p = h.eval(-1.2 + 1.9 * k as f64 / 20.0) - f.origin;
         let (x, y) = (p.dot(f.x) / 2.0, p.dot(f.y) / 0.5);
@@ -150,23 +150,23 @@ fn plane_and_line() {
 fn cylinder_cone_sphere_torus_match_iso_10303_42() {
     let f = tilted();
     let around = |rho: f64, u: f64, z: f64| f.point(rho * u.cos(), rho * u.sin(), z);
-    let cyl = cylinder(&f, 1.5, 0.2, 5.0, -1.0, 2.0).unwrap();
+    let cyl = cylinder(&f, 1.5, [0.2, 5.0], [-1.0, 2.0]).unwrap();
     check_surface(&cyl, |u, v| around(1.5, u, v), 3.0);
     let alpha = 0.4f64;
-    let con = cone(&f, 1.0, alpha, -PI, PI, -2.0, 1.0).unwrap();
+    let con = cone(&f, 1.0, alpha, [-PI, PI], [-2.0, 1.0]).unwrap();
     check_surface(&con, |u, v| around(1.0 + v * alpha.tan(), u, v), 3.0);
-    let sph = sphere(&f, 2.0, 0.0, TAU, -FRAC_PI_2, FRAC_PI_2).unwrap();
+    let sph = sphere(&f, 2.0, [0.0, TAU], [-FRAC_PI_2, FRAC_PI_2]).unwrap();
     check_surface(&sph, |u, v| around(2.0 * v.cos(), u, 2.0 * v.sin()), 2.0);
-    let part = sphere(&f, 2.0, 1.0, 2.0, -0.3, 1.2).unwrap();
+    let part = sphere(&f, 2.0, [1.0, 2.0], [-0.3, 1.2]).unwrap();
     check_surface(&part, |u, v| around(2.0 * v.cos(), u, 2.0 * v.sin()), 2.0);
-    let tor = torus(&f, 3.0, 0.75, 0.0, TAU, -PI, 2.0).unwrap();
+    let tor = torus(&f, 3.0, 0.75, [0.0, TAU], [-PI, 2.0]).unwrap();
     check_surface(
         &tor,
         |u, v| around(3.0 + 0.75 * v.cos(), u, 0.75 * v.sin()),
         4.0,
     );
     // 16 patches for the full torus (four quadrants each way), as the 9-point circle.
-    let full = torus(&f, 3.0, 0.75, 0.0, TAU, 0.0, TAU).unwrap();
+    let full = torus(&f, 3.0, 0.75, [0.0, TAU], [0.0, TAU]).unwrap();
     assert_eq!(full.0.to_bezier_patches().len(), 16);
 }
 
