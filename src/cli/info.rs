@@ -4,6 +4,7 @@ use std::io::Write;
 use std::process::ExitCode;
 
 use crate::cli::args::InfoArgs;
+use crate::scene::load::InputKind;
 use crate::scene::load_scene;
 use crate::scene::summary::summarize;
 
@@ -60,5 +61,10 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
         }
     )?;
     writeln!(out, "max depth: {}", s.max_depth)?;
+    if InputKind::of(&args.scene) == Some(InputKind::Iges) {
+        for line in crate::scene::iges::read_iges(&args.scene)?.report.lines() {
+            writeln!(out, "{line}")?;
+        }
+    }
     Ok(ExitCode::SUCCESS)
 }

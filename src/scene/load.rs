@@ -3,8 +3,9 @@
 use std::path::Path;
 
 use super::error::LoadError;
+use super::model::Material;
 use super::model::{Geometry, Object, Scene, Surface};
-use super::{bpt, mesh, obj, pbrt, ron_format};
+use super::{bpt, iges, mesh, obj, pbrt, ron_format};
 
 /// The kinds of input file we read, by extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -14,6 +15,7 @@ pub enum InputKind {
     Obj,
     Pbrt,
     Gltf,
+    Iges,
 }
 
 impl InputKind {
@@ -25,6 +27,7 @@ impl InputKind {
             "obj" => InputKind::Obj,
             "pbrt" => InputKind::Pbrt,
             "gltf" | "glb" => InputKind::Gltf,
+            "igs" | "iges" => InputKind::Iges,
             _ => return None,
         })
     }
@@ -33,7 +36,7 @@ impl InputKind {
 fn unknown_kind(path: &Path) -> LoadError {
     LoadError::invalid(
         path,
-        "unknown file type: expected .ron (scene), .bpt, .obj, .pbrt, .gltf or .glb",
+        "unknown file type: expected .ron (scene), .bpt, .obj, .pbrt, .gltf, .glb, .igs or .iges",
     )
 }
 
@@ -59,6 +62,13 @@ pub fn load_geometry(path: &Path) -> Result<Geometry, LoadError> {
             Ok(Geometry::Surfaces(pbrt::parse_pbrt(path, &src)?))
         }
         InputKind::Gltf => Ok(Geometry::Mesh(mesh::read_gltf(path)?)),
+        InputKind::Iges => Ok(Geometry::Surfaces(
+            read_iges_warning(path)?
+                .surfaces
+                .into_iter()
+                .map(|d| d.surface)
+                .collect(),
+        )),
         InputKind::Ron => Err(LoadError::invalid(
             path,
             "a scene cannot be used as geometry; reference its geometry files instead",
@@ -114,9 +124,84 @@ pub fn check_f32_range(path: &Path, scene: &Scene) -> Result<(), LoadError> {
     Ok(())
 }
 
+/// Reads an IGES file and prints what was not drawn as one warning line on stderr (and
+/// each surface that could not be converted), so nothing is dropped silently.
+fn read_iges_warning(path: &Path) -> Result<iges::Iges, LoadError> {
+    let read = iges::read_iges(path)?;
+    let r = &read.report;
+    if let Some(line) = r.ignored_line() {
+        eprintln!("warning: {}: {line}", path.display());
+    }
+    for f in &r.failed {
+        eprintln!("warning: {}: surface not converted: {f}", path.display());
+    }
+    if r.projected > 0 {
+        eprintln!(
+            "warning: {}: {} trim curve(s) projected from model space, largest projection error {:e}",
+            path.display(),
+            r.projected,
+            r.max_projection_error
+        );
+    }
+    Ok(read)
+}
+
+/// A bare IGES file as a scene: one object per colour (IGES 314 or the Directory Entry's
+/// predefined colour), each with its material, framed like any bare geometry.
+fn iges_scene(path: &Path) -> Result<Scene, LoadError> {
+    let read = read_iges_warning(path)?;
+    let stem = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut colours: Vec<Option<glam::DVec3>> = Vec::new();
+    let mut groups: Vec<Vec<super::model::Surface>> = Vec::new();
+    for d in read.surfaces {
+        let k = match colours.iter().position(|c| *c == d.colour) {
+            Some(k) => k,
+            None => {
+                colours.push(d.colour);
+                groups.push(Vec::new());
+                colours.len() - 1
+            }
+        };
+        groups[k].push(d.surface);
+    }
+    let mut materials = vec![Material::default_named("default")];
+    let objects = colours
+        .iter()
+        .zip(groups)
+        .enumerate()
+        .map(|(k, (colour, surfaces))| {
+            let material = match colour {
+                Some(rgb) => {
+                    let mut m = Material::default_named(&format!("iges_colour_{k}"));
+                    m.diffuse = rgb.as_vec3();
+                    materials.push(m);
+                    materials.len() - 1
+                }
+                None => 0,
+            };
+            Object {
+                name: if k == 0 {
+                    stem.clone()
+                } else {
+                    format!("{stem}#{k}")
+                },
+                material,
+                geometry: Geometry::Surfaces(surfaces),
+            }
+        })
+        .collect();
+    let mut scene = Scene::framing(objects);
+    scene.materials = materials;
+    Ok(scene)
+}
+
 fn read_any_scene(path: &Path) -> Result<Scene, LoadError> {
     match InputKind::of(path).ok_or_else(|| unknown_kind(path))? {
         InputKind::Ron => ron_format::read_scene(path),
+        InputKind::Iges => iges_scene(path),
         _ => {
             let geometry = load_geometry(path)?;
             let name = path
