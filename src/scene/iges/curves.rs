@@ -86,12 +86,15 @@ fn pieces_at(model: &Model, pointer: usize, depth: usize) -> Result<Vec<Piece>, 
             };
             crate::geom::nurbs::knots::validate(c.degree, &curve.knots, curve.points.len())
                 .map_err(|e| e.to_string())?;
-            if c.weights.iter().any(|w| !(*w > 0.0)) {
+            if c.weights
+                .iter()
+                .any(|w| w.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
+            {
                 return Err("a weight is not positive".into());
             }
             let (d0, d1) = crate::geom::nurbs::knots::domain(c.degree, &curve.knots);
             let (t0, t1) = (c.range[0].max(d0), c.range[1].min(d1));
-            if !(t0 < t1) {
+            if t0.partial_cmp(&t1) != Some(std::cmp::Ordering::Less) {
                 return Err(format!(
                     "the parameter range [{}, {}] is empty",
                     c.range[0], c.range[1]
@@ -236,7 +239,11 @@ fn polyline(points: &[DVec3]) -> Result<Piece, String> {
 /// Bézier form on [0, 1] (coefficients scaled by powers of h, then the power-to-Bernstein
 /// conversion), joined with triple knots at the breaks: the same curve exactly.
 fn spline(breaks: &[f64], coefficients: &[[[f64; 4]; 3]]) -> Result<Piece, String> {
-    if coefficients.is_empty() || breaks.windows(2).any(|w| !(w[1] > w[0])) {
+    if coefficients.is_empty()
+        || breaks
+            .windows(2)
+            .any(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+    {
         return Err("the breakpoints of a parametric spline must increase".into());
     }
     let mut knots = vec![breaks[0]; 4];

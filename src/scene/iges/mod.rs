@@ -41,7 +41,7 @@ impl Model {
     /// The entry and entity a directory pointer (odd sequence number) names.
     pub fn get(&self, pointer: usize) -> Result<(&DirEntry, &Entity), String> {
         let i = pointer.wrapping_sub(1) / 2;
-        if pointer % 2 == 0 || i >= self.entries.len() {
+        if pointer.is_multiple_of(2) || i >= self.entries.len() {
             return Err(format!("D {pointer} is not a directory entry of this file"));
         }
         Ok((&self.entries[i], &self.entities[i]))

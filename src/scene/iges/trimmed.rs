@@ -78,10 +78,10 @@ pub fn trimmed(model: &Model, pointer: usize, report: &mut Report) -> Result<Sur
 /// The surface with its loops; a 128 whose range is narrower than its knots and that has
 /// no outer loop gets the range as one (its domain, §4.24, is the range).
 fn finish(c: Converted, mut loops: Vec<TrimLoop>) -> Surface {
-    if let Some([u0, u1, v0, v1]) = c.range {
-        if loops.iter().all(|l| l.hole) {
-            loops.insert(0, rectangle(u0, u1, v0, v1));
-        }
+    if let Some([u0, u1, v0, v1]) = c.range
+        && loops.iter().all(|l| l.hole)
+    {
+        loops.insert(0, rectangle(u0, u1, v0, v1));
     }
     Surface {
         geometry: SurfaceGeometry::Nurbs(c.surface),
@@ -184,7 +184,7 @@ fn boundary(
         let mut points = Vec::new();
         for seg in piece.curve.bezier_segments() {
             let (a, b) = (seg.t0.max(piece.t0), seg.t1.min(piece.t1));
-            if !(a < b) {
+            if a >= b || a.is_nan() || b.is_nan() {
                 continue;
             }
             let first = if points.is_empty() { 0 } else { 1 };
