@@ -10,19 +10,26 @@ use super::Model;
 use super::entities::Entity;
 use crate::geom::nurbs::NurbsCurve;
 use crate::geom::nurbs::analytic::{self, Frame};
+use crate::geom::trim::AxisMap;
 
-/// One piece of a curve: a NURBS curve used on `[t0, t1]`.
+/// One piece of a curve: a NURBS curve used on `[t0, t1]`, and the map from its NURBS
+/// parameter to the entity's own (the angle, for arcs).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Piece {
     pub curve: NurbsCurve,
     pub t0: f64,
     pub t1: f64,
+    pub map: AxisMap,
 }
 
 impl Piece {
     fn whole(curve: NurbsCurve) -> Piece {
+        Piece::mapped((curve, AxisMap::Identity))
+    }
+
+    fn mapped((curve, map): (NurbsCurve, AxisMap)) -> Piece {
         let (t0, t1) = crate::geom::nurbs::knots::domain(curve.degree, &curve.knots);
-        Piece { curve, t0, t1 }
+        Piece { curve, t0, t1, map }
     }
 }
 
@@ -84,6 +91,9 @@ fn pieces_at(model: &Model, pointer: usize, depth: usize) -> Result<Vec<Piece>, 
                     .map(|(p, &w)| (*p * w).extend(w))
                     .collect(),
             };
+            if c.degree == 0 {
+                return Err("degree 0 is outside 1..=15".into());
+            }
             crate::geom::nurbs::knots::validate(c.degree, &curve.knots, curve.points.len())
                 .map_err(|e| e.to_string())?;
             if c.weights
@@ -100,7 +110,12 @@ fn pieces_at(model: &Model, pointer: usize, depth: usize) -> Result<Vec<Piece>, 
                     c.range[0], c.range[1]
                 ));
             }
-            vec![Piece { curve, t0, t1 }]
+            vec![Piece {
+                curve,
+                t0,
+                t1,
+                map: AxisMap::Identity,
+            }]
         }
         other => {
             return Err(format!(
@@ -147,9 +162,9 @@ fn arc(z: f64, centre: DVec2, start: DVec2, end: DVec2) -> Result<Piece, String>
     while a1 <= a0 {
         a1 += TAU;
     }
-    let (curve, _) =
-        analytic::circle_arc(&plane_frame(z), radius, a0, a1).map_err(|e| e.to_string())?;
-    Ok(Piece::whole(curve))
+    Ok(Piece::mapped(
+        analytic::circle_arc(&plane_frame(z), radius, a0, a1).map_err(|e| e.to_string())?,
+    ))
 }
 
 /// 104 (§4.5): an ellipse in general position (B² < 4AC) is brought to its centre and axes
@@ -191,8 +206,9 @@ fn conic(k: &[f64; 6], z: f64, start: DVec2, end: DVec2) -> Result<Piece, String
         while t1 <= t0 {
             t1 += TAU;
         }
-        let (curve, _) = analytic::ellipse_arc(&frame, ra, rb, [t0, t1]).map_err(err)?;
-        return Ok(Piece::whole(curve));
+        return Ok(Piece::mapped(
+            analytic::ellipse_arc(&frame, ra, rb, [t0, t1]).map_err(err)?,
+        ));
     }
     let frame = plane_frame(z);
     if disc == 0.0 && b == 0.0 && f == 0.0 {

@@ -19,7 +19,12 @@ pub struct Converted {
     pub surface: NurbsSurface,
     pub maps: [AxisMap; 2],
     pub range: Option<[f64; 4]>,
+    /// Per direction `(scale, offset)`: the trim parameter is `offset + scale · p` for the
+    /// entity's parameter p (the 122's normalised u is the directrix parameter scaled).
+    pub to_trim: [(f64, f64); 2],
 }
+
+const SAME: [(f64, f64); 2] = [(1.0, 0.0), (1.0, 0.0)];
 
 fn err(e: impl std::fmt::Display) -> String {
     e.to_string()
@@ -53,6 +58,7 @@ pub fn surface(model: &Model, pointer: usize) -> Result<Converted, String> {
                 surface: s,
                 maps: Default::default(),
                 range: (narrower && u0 < u1 && v0 < v1).then_some(b.range),
+                to_trim: SAME,
             }
         }
         Entity::Ruled {
@@ -68,11 +74,15 @@ pub fn surface(model: &Model, pointer: usize) -> Result<Converted, String> {
             if *reversed {
                 c2 = reverse(&c2);
             }
+            if c1.map != AxisMap::Identity || c2.map != AxisMap::Identity {
+                return Err("a ruled surface between arcs or ellipses is not supported yet (its normalised parameter has no exact map to the arc angle once the rails' breaks are merged)".into());
+            }
             let (s, maps) = analytic::ruled(&c1.curve, &c2.curve).map_err(err)?;
             Converted {
                 surface: s,
                 maps,
                 range: None,
+                to_trim: SAME,
             }
         }
         Entity::Revolution {
@@ -88,24 +98,27 @@ pub fn surface(model: &Model, pointer: usize) -> Result<Converted, String> {
             let m = model.transform(model.get(*axis)?.0.transform)?;
             let (p0, p1) = (m.transform_point3(*start), m.transform_point3(*end));
             let g = single(curves::pieces(model, *generatrix)?)?;
-            let (s, [angle, along]) =
+            let (s, [angle, _]) =
                 analytic::revolution(&g.curve, p0, p1 - p0, angles[0], angles[1]).map_err(err)?;
             Converted {
                 surface: s.transposed(),
-                maps: [along, angle],
+                maps: [g.map, angle],
                 range: None,
+                to_trim: SAME,
             }
         }
         Entity::Tabulated { directrix, end } => {
             // §4.19: S(u, v) = C(t) + v (L − C(t0)), t = t0 + u (t1 − t0), u, v in [0, 1].
+            // The NURBS u is the directrix's own parameter, so trims map to t.
             let c = single(curves::pieces(model, *directrix)?)?;
             let start = c.curve.eval(c.t0);
-            let unit = normalised(&c);
-            let (s, maps) = analytic::extrusion(&unit, *end - start, 0.0, 1.0).map_err(err)?;
+            let (s, [_, along]) =
+                analytic::extrusion(&c.curve, *end - start, 0.0, 1.0).map_err(err)?;
             Converted {
                 surface: s,
-                maps,
+                maps: [c.map, along],
                 range: None,
+                to_trim: [(c.t1 - c.t0, c.t0), (1.0, 0.0)],
             }
         }
         _ => {
@@ -131,15 +144,6 @@ fn single(mut pieces: Vec<Piece>) -> Result<Piece, String> {
     Ok(pieces.remove(0))
 }
 
-/// The curve's knots mapped affinely so that [t0, t1] becomes [0, 1] (the same curve).
-fn normalised(p: &Piece) -> NurbsCurve {
-    let h = p.t1 - p.t0;
-    NurbsCurve {
-        knots: p.curve.knots.iter().map(|k| (k - p.t0) / h).collect(),
-        ..p.curve.clone()
-    }
-}
-
 /// The same curve run backwards: knots reflected, points reversed.
 fn reverse(p: &Piece) -> Piece {
     let (a, b) = (p.curve.knots[0], p.curve.knots[p.curve.knots.len() - 1]);
@@ -153,5 +157,6 @@ fn reverse(p: &Piece) -> Piece {
         },
         t0: a + b - p.t1,
         t1: a + b - p.t0,
+        map: p.map.clone(),
     }
 }

@@ -155,6 +155,8 @@ fn boundary(
         ));
     };
     if *parameter_curve != 0 && (*preferred != 2 || *model_curve == 0) {
+        // Affine in (u, v), so exact on the homogeneous points.
+        let [(su, ou), (sv, ov)] = c.to_trim;
         return Ok(curves::pieces(model, *parameter_curve)?
             .into_iter()
             .map(|p| TrimSegment {
@@ -167,7 +169,7 @@ fn boundary(
                         .curve
                         .points
                         .iter()
-                        .map(|q| DVec3::new(q.x, q.y, q.w))
+                        .map(|q| DVec3::new(su * q.x + ou * q.w, sv * q.y + ov * q.w, q.w))
                         .collect(),
                 },
             })
