@@ -1,4 +1,4 @@
-//! Parser robustness (issue 7): valid files of every text format, mutated (bytes flipped,
+//! Parser robustness (issue 7; IGES: issue 16): valid files of every text format, mutated (bytes flipped,
 //! lines dropped or repeated, numbers replaced by NaN, huge or empty values), never make a
 //! parser panic: each mutation gives a scene or an error with a location.
 //!
@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 
-use patchtrace::scene::{ParseError, bpt, obj, pbrt, rays, ron_format};
+use patchtrace::scene::{ParseError, bpt, iges, obj, pbrt, rays, ron_format};
 
 fn cases() -> u32 {
     std::env::var("PATCHTRACE_FUZZ_CASES")
@@ -179,6 +179,11 @@ fn pbrt_parser_survives_mutations() {
 #[test]
 fn ron_parser_survives_mutations() {
     fuzz("ron", ron_format::parse_scene_file);
+}
+
+#[test]
+fn iges_parser_survives_mutations() {
+    fuzz("igs", |p, s| iges::parse_iges(p, s).map(|_| ()));
 }
 
 #[test]

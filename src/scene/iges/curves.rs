@@ -143,9 +143,10 @@ fn transform(c: &mut NurbsCurve, m: &glam::DAffine3) {
     }
 }
 
-fn plane_frame(z: f64) -> Frame {
+/// The definition space's axes about `origin`.
+fn plane_frame(origin: DVec3) -> Frame {
     Frame {
-        origin: DVec3::new(0.0, 0.0, z),
+        origin,
         x: DVec3::X,
         y: DVec3::Y,
         z: DVec3::Z,
@@ -163,7 +164,8 @@ fn arc(z: f64, centre: DVec2, start: DVec2, end: DVec2) -> Result<Piece, String>
         a1 += TAU;
     }
     Ok(Piece::mapped(
-        analytic::circle_arc(&plane_frame(z), radius, a0, a1).map_err(|e| e.to_string())?,
+        analytic::circle_arc(&plane_frame(centre.extend(z)), radius, a0, a1)
+            .map_err(|e| e.to_string())?,
     ))
 }
 
@@ -210,7 +212,7 @@ fn conic(k: &[f64; 6], z: f64, start: DVec2, end: DVec2) -> Result<Piece, String
             analytic::ellipse_arc(&frame, ra, rb, [t0, t1]).map_err(err)?,
         ));
     }
-    let frame = plane_frame(z);
+    let frame = plane_frame(DVec3::new(0.0, 0.0, z));
     if disc == 0.0 && b == 0.0 && f == 0.0 {
         if c == 0.0 && d == 0.0 && a != 0.0 && e != 0.0 {
             // y = −(A/E) x²: the parabola of `analytic` with its axes swapped.
