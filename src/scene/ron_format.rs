@@ -11,6 +11,7 @@ use super::error::{LoadError, ParseError};
 use super::model::*;
 use crate::geom::BezierPatch;
 use crate::geom::nurbs::NurbsSurface;
+use crate::geom::trim::{AxisMap, ParamCurve, TrimLoop, TrimSegment};
 
 type V3 = (f64, f64, f64);
 type C3 = (f32, f32, f32);
@@ -128,7 +129,38 @@ pub enum SurfaceDef {
         points: Vec<V3>,
         #[serde(default, skip_serializing_if = "Option::is_none")]
         weights: Option<Vec<f64>>,
+        /// Trim loops (even–odd over all loops) in the trim parameter space.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        trims: Vec<TrimLoopDef>,
+        /// How (u, v) map to the trim parameters; identity when absent.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        trim_space: Option<(AxisMapDef, AxisMapDef)>,
     },
+}
+
+/// A trim loop: the outer boundary or a hole.
+#[derive(Debug, Serialize, Deserialize)]
+pub struct TrimLoopDef {
+    pub hole: bool,
+    pub segments: Vec<TrimSegmentDef>,
+}
+
+/// A B-spline trim curve restricted to `[t0, t1]`: homogeneous points `(w u, w v, w)` and
+/// `points + degree + 1` knots.
+#[derive(Debug, Serialize, Deserialize)]
+pub struct TrimSegmentDef {
+    pub t0: f64,
+    pub t1: f64,
+    pub degree: usize,
+    pub knots: Vec<f64>,
+    pub points: Vec<V3>,
+}
+
+/// [`AxisMap`] in the file.
+#[derive(Debug, Serialize, Deserialize)]
+pub enum AxisMapDef {
+    Identity,
+    Arcs { breaks: Vec<f64>, angles: Vec<f64> },
 }
 
 /// Transforms, applied in the order listed.
@@ -403,6 +435,8 @@ fn surface_from_def(d: &SurfaceDef) -> Result<Surface, crate::geom::GeomError> {
             count,
             points,
             weights,
+            trims,
+            trim_space,
         } => Surface {
             geometry: SurfaceGeometry::Nurbs(NurbsSurface::new(
                 degree.0,
@@ -413,10 +447,96 @@ fn surface_from_def(d: &SurfaceDef) -> Result<Surface, crate::geom::GeomError> {
                 count.1,
                 homogeneous(points, weights)?,
             )?),
-            trims: Vec::new(),
-            trim_space: Default::default(),
+            trims: trims
+                .iter()
+                .enumerate()
+                .map(|(i, l)| trim_loop_from_def(i, l))
+                .collect::<Result<_, _>>()?,
+            trim_space: match trim_space {
+                None => Default::default(),
+                Some((u, v)) => [axis_map_from_def(u)?, axis_map_from_def(v)?],
+            },
         },
     })
+}
+
+/// A trim loop, validated as the kernels expect: degrees 1..=15, valid knot vectors, finite
+/// points with positive weights, finite non-empty ranges.
+fn trim_loop_from_def(i: usize, l: &TrimLoopDef) -> Result<TrimLoop, crate::geom::GeomError> {
+    let bad = |j: usize, what: String| {
+        crate::geom::GeomError::Knots(format!("trim loop {i}, segment {j}: {what}"))
+    };
+    let segments = l
+        .segments
+        .iter()
+        .enumerate()
+        .map(|(j, s)| {
+            if !(1..=crate::geom::MAX_DEGREE).contains(&s.degree) {
+                return Err(bad(j, format!("degree {} is outside 1..=15", s.degree)));
+            }
+            crate::geom::nurbs::knots::validate(s.degree, &s.knots, s.points.len())
+                .map_err(|e| bad(j, e.to_string()))?;
+            if s.points
+                .iter()
+                .any(|p| !(p.0.is_finite() && p.1.is_finite() && p.2 > 0.0 && p.2.is_finite()))
+            {
+                return Err(bad(j, "points must be finite with positive weights".into()));
+            }
+            if !(s.t0.is_finite() && s.t1.is_finite() && s.t0 < s.t1) {
+                return Err(bad(
+                    j,
+                    format!("the range [{}, {}] is empty or not finite", s.t0, s.t1),
+                ));
+            }
+            Ok(TrimSegment {
+                t0: s.t0,
+                t1: s.t1,
+                curve: ParamCurve {
+                    degree: s.degree,
+                    knots: s.knots.clone(),
+                    points: s.points.iter().map(|&p| v3(p)).collect(),
+                },
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(TrimLoop {
+        hole: l.hole,
+        segments,
+    })
+}
+
+fn axis_map_from_def(d: &AxisMapDef) -> Result<AxisMap, crate::geom::GeomError> {
+    Ok(match d {
+        AxisMapDef::Identity => AxisMap::Identity,
+        AxisMapDef::Arcs { breaks, angles } => {
+            let increasing =
+                |v: &[f64]| v.iter().all(|x| x.is_finite()) && v.windows(2).all(|w| w[0] < w[1]);
+            if breaks.len() != angles.len()
+                || breaks.len() < 2
+                || !increasing(breaks)
+                || !increasing(angles)
+            {
+                return Err(crate::geom::GeomError::Knots(
+                    "trim_space: Arcs needs as many breaks as angles (at least 2), both increasing"
+                        .into(),
+                ));
+            }
+            AxisMap::Arcs {
+                breaks: breaks.clone(),
+                angles: angles.clone(),
+            }
+        }
+    })
+}
+
+fn axis_map_def(m: &AxisMap) -> AxisMapDef {
+    match m {
+        AxisMap::Identity => AxisMapDef::Identity,
+        AxisMap::Arcs { breaks, angles } => AxisMapDef::Arcs {
+            breaks: breaks.clone(),
+            angles: angles.clone(),
+        },
+    }
 }
 
 fn split_homogeneous(points: &[glam::DVec4]) -> (Vec<V3>, Option<Vec<f64>>) {
@@ -471,6 +591,35 @@ pub fn scene_to_file(scene: &Scene) -> Result<SceneFile, String> {
                         count: (n.count_u, n.count_v),
                         points,
                         weights,
+                        trims: s
+                            .trims
+                            .iter()
+                            .map(|l| TrimLoopDef {
+                                hole: l.hole,
+                                segments: l
+                                    .segments
+                                    .iter()
+                                    .map(|g| TrimSegmentDef {
+                                        t0: g.t0,
+                                        t1: g.t1,
+                                        degree: g.curve.degree,
+                                        knots: g.curve.knots.clone(),
+                                        points: g
+                                            .curve
+                                            .points
+                                            .iter()
+                                            .map(|p| (p.x, p.y, p.z))
+                                            .collect(),
+                                    })
+                                    .collect(),
+                            })
+                            .collect(),
+                        trim_space: (s.trim_space != <[AxisMap; 2]>::default()).then(|| {
+                            (
+                                axis_map_def(&s.trim_space[0]),
+                                axis_map_def(&s.trim_space[1]),
+                            )
+                        }),
                     }
                 }
             })
