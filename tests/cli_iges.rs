@@ -73,7 +73,12 @@ fn import_to_ron_keeps_trims_and_trim_spaces() {
     let dir = tempfile::tempdir().unwrap();
     for input in [gismo("hammer.iges"), testdata("trimmed_patch.igs")] {
         let out = dir.path().join("scene.ron");
-        let o = run(&["import", input.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+        let o = run(&[
+            "import",
+            input.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ]);
         assert!(o.status.success(), "{}", stderr(&o));
         let a = patchtrace::scene::load_scene(&input).unwrap();
         let b = patchtrace::scene::load_scene(&out).unwrap();
@@ -87,7 +92,11 @@ fn import_to_ron_keeps_trims_and_trim_spaces() {
                 .collect()
         };
         let (sa, sb) = (surfaces(&a), surfaces(&b));
-        assert!(sa.iter().any(|s| !s.trims.is_empty()), "{}", input.display());
+        assert!(
+            sa.iter().any(|s| !s.trims.is_empty()),
+            "{}",
+            input.display()
+        );
         // RON writes f64 so that it reads back exactly.
         assert_eq!(sa, sb, "{}", input.display());
     }

@@ -13,10 +13,13 @@ use patchtrace::geom::trim::{ParamCurve, TrimLoop};
 use patchtrace::scene::iges::{Iges, parse_iges};
 use patchtrace::scene::model::{Surface, SurfaceGeometry};
 
+mod iges_support;
+use iges_support::{Entry, fixed_format};
+
 const REL: f64 = 1e-12;
 
 // ---------------------------------------------------------------------------------------
-// A minimal IGES writer (fixed format, IGES 5.3 §2).
+// Entities for the writer in `iges_support`.
 
 struct Ent {
     ty: i32,
@@ -55,67 +58,20 @@ fn de(k: usize) -> f64 {
 }
 
 fn write_iges(ents: &[Ent]) -> String {
-    let mut out = format!("{:<72}S{:>7}\n", "patchtrace test", 1);
     let global = ",,4Htest,8Htest.igs,2Hpt,2Hpt,32,38,6,308,15,4Htest,1.,2,2HMM,1,0.1,\
                   13H260101.000000,1.E-6,100.,2Hme,2Hus,11,0;";
-    let g: Vec<String> = global
-        .as_bytes()
-        .chunks(72)
-        .map(|c| String::from_utf8_lossy(c).into_owned())
+    let entries: Vec<Entry> = ents
+        .iter()
+        .map(|e| Entry {
+            ty: e.ty,
+            form: e.form,
+            fields: e.params.clone(),
+            transform: e.transform,
+            colour: e.colour,
+            status: format!("00{:02}0000", e.subordinate),
+        })
         .collect();
-    for (i, line) in g.iter().enumerate() {
-        out += &format!("{line:<72}G{:>7}\n", i + 1);
-    }
-    let mut d = String::new();
-    let mut p = String::new();
-    let mut pline = 1;
-    for (k, e) in ents.iter().enumerate() {
-        let seq = 2 * k + 1;
-        let mut fields = vec![e.ty.to_string()];
-        fields.extend(e.params.iter().cloned());
-        let mut lines: Vec<String> = vec![String::new()];
-        for (i, f) in fields.iter().enumerate() {
-            let token = format!("{f}{}", if i + 1 == fields.len() { ';' } else { ',' });
-            if lines.last().unwrap().len() + token.len() > 64 {
-                lines.push(String::new());
-            }
-            *lines.last_mut().unwrap() += &token;
-        }
-        let status = format!("00{:02}0000", e.subordinate);
-        d += &format!(
-            "{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}D{:>7}\n",
-            e.ty, pline, 0, 0, 0, 0, e.transform, 0, status, seq
-        );
-        d += &format!(
-            "{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}D{:>7}\n",
-            e.ty,
-            0,
-            e.colour,
-            lines.len(),
-            e.form,
-            "",
-            "",
-            "",
-            0,
-            seq + 1
-        );
-        for l in &lines {
-            p += &format!("{l:<64}{seq:>8}P{pline:>7}\n");
-            pline += 1;
-        }
-    }
-    out += &d;
-    out += &p;
-    out += &format!(
-        "S{:>7}G{:>7}D{:>7}P{:>7}{:40}T{:>7}\n",
-        1,
-        g.len(),
-        2 * ents.len(),
-        pline - 1,
-        "",
-        1
-    );
-    out
+    fixed_format(global, &entries)
 }
 
 fn read(ents: &[Ent]) -> Iges {
@@ -263,6 +219,8 @@ fn b_spline_surface_with_transform_colour_and_parameter_space_trims() {
     let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
     let mut surf = ent(128, &b128(&n, [0.0, 1.0, 0.0, 1.0]));
     surf.transform = 3;
+    // Marked independent, as some writers do: still drawn only through the 144.
+    surf.subordinate = 0;
     let square = [(0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.1, 0.9), (0.1, 0.1)];
     let mut ents = vec![
         surf,

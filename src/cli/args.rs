@@ -141,7 +141,10 @@ pub struct TeapotsArgs {
 
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// Scene (.ron) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb).
+    /// Scene (.ron) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb, .igs, .iges). For
+    /// IGES also prints the file's units, the entities not read (by type), surfaces that
+    /// could not be converted, and the largest error of trim curves projected from model
+    /// space.
     pub scene: PathBuf,
     /// Print JSON instead of text.
     #[arg(long)]
@@ -150,10 +153,10 @@ pub struct InfoArgs {
 
 #[derive(Debug, Args)]
 pub struct ImportArgs {
-    /// Input scene or geometry file.
+    /// Input scene or geometry file (IGES 5.3 `.igs`/`.iges` included).
     pub input: PathBuf,
-    /// Output: .ron (scene, geometry inline), .bpt (non-rational patches) or .obj
-    /// (free-form Bézier patches).
+    /// Output: .ron (scene, geometry inline, NURBS with their trim loops), .bpt
+    /// (non-rational patches) or .obj (free-form Bézier patches).
     #[arg(short, long)]
     pub output: PathBuf,
 }

@@ -286,9 +286,19 @@ pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
         entities.push(entities::read(&p)?);
     }
     let model = Model { entries, entities };
+    // Some writers leave the surface under a 144 marked independent; it is drawn through
+    // the 144 only (drawn again, its untrimmed whole would cover the trims).
+    let trimmed: std::collections::HashSet<usize> = model
+        .entities
+        .iter()
+        .filter_map(|e| match e {
+            Entity::Trimmed { surface, .. } => Some(*surface),
+            _ => None,
+        })
+        .collect();
     let mut surfaces = Vec::new();
     for (entry, entity) in model.entries.iter().zip(&model.entities) {
-        if !entry.is_drawn() {
+        if !entry.is_drawn() || trimmed.contains(&entry.sequence) {
             continue;
         }
         let converted = match entity {

@@ -135,6 +135,17 @@ struct Joined {
     origin: Vec<(usize, usize)>,
 }
 
+impl Joined {
+    /// The (line, column) of byte `i`, or of the last byte when `i` is past the end.
+    fn at(&self, i: usize) -> (usize, usize) {
+        self.origin
+            .get(i)
+            .or(self.origin.last())
+            .copied()
+            .unwrap_or((1, 1))
+    }
+}
+
 fn join(records: &[Record<'_>]) -> Joined {
     let mut text = Vec::new();
     let mut origin = Vec::new();
@@ -151,13 +162,7 @@ fn join(records: &[Record<'_>]) -> Joined {
 pub fn global(path: &Path, records: &[Record<'_>]) -> Result<(Delimiters, Vec<Token>), ParseError> {
     let j = join(records);
     let t = &j.text;
-    let at = |i: usize| {
-        j.origin
-            .get(i)
-            .or(j.origin.last())
-            .copied()
-            .unwrap_or((1, 1))
-    };
+    let at = |i: usize| j.at(i);
     // §2.2.4.1: parameter 1 is `1Hc` or empty (then ','); parameter 2 likewise (';').
     let declared = |i: usize| -> Option<u8> {
         (t.get(i) == Some(&b'1') && t.get(i + 1).is_some_and(|h| h.eq_ignore_ascii_case(&b'H')))
@@ -242,13 +247,7 @@ fn tokenize(
     delims: Delimiters,
 ) -> Result<Vec<Token>, ParseError> {
     let t = &j.text;
-    let at = |i: usize| {
-        j.origin
-            .get(i)
-            .or(j.origin.last())
-            .copied()
-            .unwrap_or((1, 1))
-    };
+    let at = |i: usize| j.at(i);
     let mut tokens = Vec::new();
     let mut pos = start;
     loop {
