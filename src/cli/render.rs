@@ -47,7 +47,8 @@ impl SamplingReport {
 
 /// What made the image, as pieces record it so `merge` can refuse pieces of different
 /// renders: the program version, fingerprints of the scene as loaded (after `--width` and
-/// `--height`) and of the kernel flags, and every setting that changes pixels. `--bvh`
+/// `--height`; everything but object names, which change no pixel) and of the kernel
+/// flags, and every setting that changes pixels. `--bvh`
 /// is left out: a BVH file is the BVH the scene builds, wherever it is stored.
 fn provenance(scene: &Scene, args: &RenderArgs, samples: SampleCount) -> String {
     let kernel = crate::cli::args::KernelArgs {
@@ -58,7 +59,17 @@ fn provenance(scene: &Scene, args: &RenderArgs, samples: SampleCount) -> String 
     format!(
         "patchtrace {}; scene {:016x}; size {}x{}; spp {samples}; filter {:?}; ulps {}; kernel {:016x}; aov [{}]",
         env!("CARGO_PKG_VERSION"),
-        fingerprint(scene),
+        fingerprint(&(
+            &scene.camera,
+            (scene.background, scene.ambient, scene.max_depth),
+            &scene.lights,
+            &scene.materials,
+            scene
+                .objects
+                .iter()
+                .map(|o| (o.material, &o.geometry))
+                .collect::<Vec<_>>(),
+        )),
         scene.camera.width,
         scene.camera.height,
         args.filter,
