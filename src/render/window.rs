@@ -189,39 +189,12 @@ mod tests {
 
     #[test]
     fn gaps_and_overlaps_are_named() {
-        let a = Window {
-            x0: 0,
-            x1: 4,
-            y0: 0,
-            y1: 2,
-        };
-        let b = Window {
-            x0: 0,
-            x1: 4,
-            y0: 1,
-            y1: 4,
-        };
-        assert_eq!(
-            check_cover(&[a, b], 4, 4),
-            Err("pixel (0, 1) is in two pieces".into())
-        );
-        let c = Window {
-            x0: 0,
-            x1: 4,
-            y0: 2,
-            y1: 4,
-        };
-        assert_eq!(
-            check_cover(&[c], 4, 4),
-            Err("pixel (0, 0) is in no piece".into())
-        );
-        let big = Window {
-            x0: 0,
-            x1: 5,
-            y0: 0,
-            y1: 4,
-        };
-        assert!(check_cover(&[big], 4, 4).is_err());
+        let w = |s: &str| s.parse::<Window>().unwrap();
+        let (a, b) = (w("0,4,0,2"), w("0,4,1,4"));
+        let err = |ws: &[Window]| check_cover(ws, 4, 4).unwrap_err();
+        assert_eq!(err(&[a, b]), "pixel (0, 1) is in two pieces");
+        assert_eq!(err(&[w("0,4,2,4")]), "pixel (0, 0) is in no piece");
+        assert!(err(&[w("0,5,0,4")]).contains("outside"));
     }
 
     #[test]
