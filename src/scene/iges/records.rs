@@ -355,7 +355,7 @@ mod tests {
 
     #[test]
     fn global_declares_its_delimiters() {
-        let (d, t) = global(Path::new("g"), &[rec("1H/,1H#/4HA/B;/1.5D2/#")]).unwrap();
+        let (d, t) = global(Path::new("g"), &[rec("1H//1H#/4HA/B;/1.5D2#")]).unwrap();
         assert_eq!((d.parameter, d.record), (b'/', b'#'));
         assert_eq!(t[2].value, Value::Text("A/B;".into()));
         assert_eq!(
