@@ -87,7 +87,7 @@ fn import_to_ron_keeps_trims_and_trim_spaces() {
                 .iter()
                 .flat_map(|o| match &o.geometry {
                     patchtrace::scene::Geometry::Surfaces(s) => s.clone(),
-                    patchtrace::scene::Geometry::Mesh(_) => Vec::new(),
+                    _ => Vec::new(),
                 })
                 .collect()
         };
