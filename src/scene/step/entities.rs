@@ -9,9 +9,11 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::rc::Rc;
 
-use glam::DVec3;
+use glam::{DVec3, DVec4};
 
 use super::records::{Exchange, Instance, Param, Record, Value};
+pub use crate::geom::nurbs::analytic::Frame;
+use crate::geom::nurbs::{NurbsCurve, NurbsSurface};
 use crate::scene::error::ParseError;
 
 /// Longest chain of references followed while resolving one entity. Real B-reps are about
@@ -19,82 +21,19 @@ use crate::scene::error::ParseError;
 /// file reaches the bound and is reported instead of overflowing the stack.
 const MAX_DEPTH: usize = 200;
 
-/// A right-handed orthonormal frame (AXIS2_PLACEMENT_3D/2D, ISO 10303-42 §4.4.13): `x` is
-/// the ref_direction made orthogonal to `z`, `y = z × x`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Frame {
-    pub origin: DVec3,
-    pub x: DVec3,
-    pub y: DVec3,
-    pub z: DVec3,
-}
-
-impl Frame {
-    /// The point `origin + a x + b y + c z`.
-    pub fn at(&self, a: f64, b: f64, c: f64) -> DVec3 {
-        self.origin + a * self.x + b * self.y + c * self.z
-    }
-
-    /// Coordinates of `p` in the frame.
-    pub fn local(&self, p: DVec3) -> DVec3 {
-        let d = p - self.origin;
-        DVec3::new(d.dot(self.x), d.dot(self.y), d.dot(self.z))
-    }
-
-    /// The frame as the affine map from its coordinates to the parent's.
-    pub fn to_affine(&self) -> glam::DAffine3 {
-        glam::DAffine3::from_mat3_translation(
-            glam::DMat3::from_cols(self.x, self.y, self.z),
-            self.origin,
-        )
-    }
-}
-
-/// B-spline data shared by curves and surfaces: knots expanded from
-/// (multiplicities, knots) as ISO 10303-42 §4.4.? `b_spline_curve_with_knots` writes them.
-#[derive(Clone, Debug, PartialEq)]
-pub struct BSplineCurve {
-    pub degree: usize,
-    pub points: Vec<DVec3>,
-    /// One per point; all 1 for a non-rational curve.
-    pub weights: Vec<f64>,
-    pub knots: Vec<f64>,
-}
-
-#[derive(Clone, Debug, PartialEq)]
-pub struct BSplineSurface {
-    pub degree_u: usize,
-    pub degree_v: usize,
-    /// `points[i][j]`, i along u (STEP writes the control net as a list over u of lists
-    /// over v).
-    pub points: Vec<Vec<DVec3>>,
-    pub weights: Vec<Vec<f64>>,
-    pub knots_u: Vec<f64>,
-    pub knots_v: Vec<f64>,
-}
-
 /// Curves (ISO 10303-42 §4.4.?): parameterisations as the standard defines them, so that
 /// pcurve and trimming parameters mean what the file means. 2D curves (in pcurves) have
 /// z = 0.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Curve {
     /// `origin + t · direction` (the direction keeps the vector's magnitude).
-    Line {
-        origin: DVec3,
-        direction: DVec3,
-    },
+    Line { origin: DVec3, direction: DVec3 },
     /// `centre + r (cos t x + sin t y)`, t in radians.
-    Circle {
-        frame: Frame,
-        radius: f64,
-    },
+    Circle { frame: Frame, radius: f64 },
     /// `centre + a cos t x + b sin t y`.
-    Ellipse {
-        frame: Frame,
-        a: f64,
-        b: f64,
-    },
-    BSpline(BSplineCurve),
+    Ellipse { frame: Frame, a: f64, b: f64 },
+    /// B_SPLINE_CURVE_WITH_KNOTS, BEZIER_CURVE and their rational forms, as read.
+    BSpline(NurbsCurve),
     /// The basis curve between two parameters (already in radians for conics);
     /// `sense` false runs it backwards.
     Trimmed {
@@ -125,10 +64,7 @@ pub enum SurfaceDef {
     /// `origin + u x + v y`.
     Plane(Frame),
     /// `origin + r (cos u x + sin u y) + v z`.
-    Cylinder {
-        frame: Frame,
-        radius: f64,
-    },
+    Cylinder { frame: Frame, radius: f64 },
     /// `origin + (r + v tan α)(cos u x + sin u y) + v z`.
     Cone {
         frame: Frame,
@@ -136,10 +72,7 @@ pub enum SurfaceDef {
         semi_angle: f64,
     },
     /// `origin + r cos v (cos u x + sin u y) + r sin v z`.
-    Sphere {
-        frame: Frame,
-        radius: f64,
-    },
+    Sphere { frame: Frame, radius: f64 },
     /// `origin + (R + r cos v)(cos u x + sin u y) + r sin v z`.
     Torus {
         frame: Frame,
@@ -158,7 +91,8 @@ pub enum SurfaceDef {
         profile: Rc<Curve>,
         direction: DVec3,
     },
-    BSpline(BSplineSurface),
+    /// B_SPLINE_SURFACE_WITH_KNOTS, BEZIER_SURFACE and their rational forms, as read.
+    BSpline(NurbsSurface),
 }
 
 /// A resolved ADVANCED_FACE (or FACE_SURFACE).
@@ -179,6 +113,8 @@ pub struct Bound {
     pub outer: bool,
     pub orientation: bool,
     pub edges: Vec<OrientedEdge>,
+    /// The point of a VERTEX_LOOP.
+    pub vertex: Option<DVec3>,
 }
 
 #[derive(Clone, Debug)]
@@ -210,6 +146,9 @@ pub struct Resolver<'e, 'a> {
     curves: RefCell<HashMap<u64, Rc<Curve>>>,
     surfaces: RefCell<HashMap<u64, Rc<SurfaceDef>>>,
     edges: RefCell<HashMap<u64, Rc<Edge>>>,
+    /// The type of the last valid but unsupported entity met (an OFFSET_SURFACE under a
+    /// face), which makes its face skipped rather than the file refused.
+    unsupported: RefCell<Option<String>>,
 }
 
 /// One record of one instance, with accessors that check kinds and locate errors.
@@ -351,6 +290,15 @@ impl<'r, 'a> Rec<'r, 'a> {
     }
 }
 
+/// Premultiplied homogeneous points `(w x, w y, w z, w)`.
+fn homogeneous(points: &[DVec3], weights: &[f64]) -> Vec<DVec4> {
+    points
+        .iter()
+        .zip(weights)
+        .map(|(p, &w)| (*p * w).extend(w))
+        .collect()
+}
+
 /// Expands B-spline knots given as distinct values and multiplicities.
 fn expand_knots(r: &Rec, mult: &Param, knots: &Param) -> Result<Vec<f64>, ParseError> {
     let m = r.list_of(mult, "knot multiplicities")?;
@@ -406,7 +354,18 @@ impl<'e, 'a> Resolver<'e, 'a> {
             curves: RefCell::default(),
             surfaces: RefCell::default(),
             edges: RefCell::default(),
+            unsupported: RefCell::default(),
         }
+    }
+
+    /// Takes the type of the unsupported entity met since the last call, if any.
+    pub fn take_unsupported(&self) -> Option<String> {
+        self.unsupported.borrow_mut().take()
+    }
+
+    fn unsupported(&self, r: &Rec, what: &str) -> ParseError {
+        *self.unsupported.borrow_mut() = Some(r.inst.type_name().into_owned());
+        r.error(format!("expected {what}"))
     }
 
     /// The instance `id`, referenced from parameter `p` of `from`.
@@ -541,25 +500,9 @@ impl<'e, 'a> Resolver<'e, 'a> {
         } else {
             (optional_dir(2)?, optional_dir(3)?)
         };
-        let z = z.unwrap_or(DVec3::Z);
-        // ISO 10303-42 first_proj_axis: the ref_direction minus its z component; a
-        // default (or parallel) ref_direction falls back to the world axis least
-        // parallel to z.
-        let hint = x_hint.unwrap_or(DVec3::X);
-        let mut x = (hint - hint.dot(z) * z).normalize_or_zero();
-        if x.length_squared() < 0.5 {
-            if x_hint.is_some() {
-                return Err(r.error("expected a ref_direction not parallel to the axis"));
-            }
-            let fallback = if z.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
-            x = (fallback - fallback.dot(z) * z).normalize();
-        }
-        Ok(Frame {
-            origin,
-            x,
-            y: z.cross(x),
-            z,
-        })
+        // ISO 10303-42 build_axes: a default axis is z, a default or parallel
+        // ref_direction falls back to a world axis.
+        Frame::new(origin, z.unwrap_or(DVec3::Z), x_hint).map_err(|e| r.error(e.to_string()))
     }
 
     /// Any supported curve (3D or, in a pcurve, 2D).
@@ -616,12 +559,18 @@ impl<'e, 'a> Resolver<'e, 'a> {
                     let id = r.reference_of(p, "a PCURVE")?;
                     let pc = self.instance(&r, id)?;
                     if pc.record("PCURVE").is_some() {
-                        pcurves.push(self.deeper(&r, || self.pcurve(pc))?);
+                        // A pcurve of a kind we do not read is dropped: the edge is then
+                        // projected instead.
+                        match self.deeper(&r, || self.pcurve(pc)) {
+                            Ok(p) => pcurves.push(p),
+                            Err(_) if self.take_unsupported().is_some() => {}
+                            Err(e) => return Err(e),
+                        }
                     }
                 }
                 Ok(Curve::OnSurface { curve, pcurves })
             }
-            _ => Err(r.error("expected a supported curve (LINE, CIRCLE, ELLIPSE, B_SPLINE_CURVE_WITH_KNOTS, BEZIER_CURVE, TRIMMED_CURVE, SURFACE_CURVE, SEAM_CURVE)")),
+            _ => Err(self.unsupported(&r, "a supported curve (LINE, CIRCLE, ELLIPSE, B_SPLINE_CURVE_WITH_KNOTS, BEZIER_CURVE, TRIMMED_CURVE, SURFACE_CURVE, SEAM_CURVE)")),
         }
     }
 
@@ -651,6 +600,7 @@ impl<'e, 'a> Resolver<'e, 'a> {
                     return Ok(r.number(inner, "a parameter value")? * scale);
                 }
             }
+            *self.unsupported.borrow_mut() = Some("TRIMMED_CURVE trimmed by points".into());
             Err(r.error_at(
                 p.line,
                 p.column,
@@ -675,7 +625,7 @@ impl<'e, 'a> Resolver<'e, 'a> {
     /// of B_SPLINE_CURVE_WITH_KNOTS (multiplicities, knots, spec) or implied by
     /// BEZIER_CURVE, weights from RATIONAL_B_SPLINE_CURVE. In a complex instance the
     /// B_SPLINE_CURVE record carries the attributes without the name.
-    fn bspline_curve(&self, inst: &'e Instance<'a>, r: &Rec) -> Result<BSplineCurve, ParseError> {
+    fn bspline_curve(&self, inst: &'e Instance<'a>, r: &Rec) -> Result<NurbsCurve, ParseError> {
         let (base, off) = match self.named(inst, "B_SPLINE_CURVE") {
             Some(b) => (b, 0),
             None => (*r, 1),
@@ -735,21 +685,19 @@ impl<'e, 'a> Resolver<'e, 'a> {
             }
             None => vec![1.0; points.len()],
         };
-        let c = BSplineCurve {
-            degree,
-            points,
-            weights,
-            knots,
-        };
-        crate::geom::nurbs::knots::validate(c.degree, &c.knots, c.points.len())
+        crate::geom::nurbs::knots::validate(degree, &knots, points.len())
             .map_err(|e| base.error(e.to_string()))?;
-        if let Some(k) = c.weights.iter().position(|w| !(*w > 0.0)) {
+        if let Some(k) = weights.iter().position(|w| !(*w > 0.0)) {
             return Err(base.error(format!(
                 "weight {k} is {}; weights must be positive",
-                c.weights[k]
+                weights[k]
             )));
         }
-        Ok(c)
+        Ok(NurbsCurve {
+            degree,
+            knots,
+            points: homogeneous(&points, &weights),
+        })
     }
 
     /// Any supported surface, cached by id (faces share their surfaces with pcurves).
@@ -827,7 +775,7 @@ impl<'e, 'a> Resolver<'e, 'a> {
                     direction: dir * magnitude,
                 })
             }
-            _ => Err(r.error("expected a supported surface (PLANE, CYLINDRICAL_SURFACE, CONICAL_SURFACE, SPHERICAL_SURFACE, TOROIDAL_SURFACE, SURFACE_OF_REVOLUTION, SURFACE_OF_LINEAR_EXTRUSION, B_SPLINE_SURFACE_WITH_KNOTS, BEZIER_SURFACE)")),
+            _ => Err(self.unsupported(&r, "a supported surface (PLANE, CYLINDRICAL_SURFACE, CONICAL_SURFACE, SPHERICAL_SURFACE, TOROIDAL_SURFACE, SURFACE_OF_REVOLUTION, SURFACE_OF_LINEAR_EXTRUSION, B_SPLINE_SURFACE_WITH_KNOTS, BEZIER_SURFACE)")),
         }
     }
 
@@ -835,7 +783,7 @@ impl<'e, 'a> Resolver<'e, 'a> {
     /// self_intersect) with knots from B_SPLINE_SURFACE_WITH_KNOTS (u_mult, v_mult,
     /// u_knots, v_knots, spec) or implied by BEZIER_SURFACE, weights from
     /// RATIONAL_B_SPLINE_SURFACE.
-    fn bspline_surface(&self, inst: &'e Instance<'a>) -> Result<BSplineSurface, ParseError> {
+    fn bspline_surface(&self, inst: &'e Instance<'a>) -> Result<NurbsSurface, ParseError> {
         let (base, off) = match self.named(inst, "B_SPLINE_SURFACE") {
             Some(b) => (b, 0),
             None => (self.rec(inst), 1),
@@ -924,14 +872,21 @@ impl<'e, 'a> Resolver<'e, 'a> {
             }
             None => vec![vec![1.0; count_v]; count_u],
         };
-        Ok(BSplineSurface {
+        // STEP's net is a list over u of lists over v; ours runs u fastest.
+        let (flat, flat_w): (Vec<DVec3>, Vec<f64>) = (0..count_v)
+            .flat_map(|j| (0..count_u).map(move |i| (i, j)))
+            .map(|(i, j)| (points[i][j], weights[i][j]))
+            .unzip();
+        NurbsSurface::new(
             degree_u,
             degree_v,
-            points,
-            weights,
             knots_u,
             knots_v,
-        })
+            count_u,
+            count_v,
+            homogeneous(&flat, &flat_w),
+        )
+        .map_err(|e| base.error(e.to_string()))
     }
 
     /// An ADVANCED_FACE or FACE_SURFACE(name, bounds, face_geometry, same_sense).
@@ -961,7 +916,10 @@ impl<'e, 'a> Resolver<'e, 'a> {
         let orientation = b.boolean(2, "orientation")?;
         let l = self.follow(b, 1, &["EDGE_LOOP", "VERTEX_LOOP"])?;
         let mut edges = Vec::new();
-        if l.rec.name == "EDGE_LOOP" {
+        let mut vertex = None;
+        if l.rec.name == "VERTEX_LOOP" {
+            vertex = Some(self.vertex(&l, 1)?);
+        } else {
             for id in l.references(1, "oriented edges")? {
                 let oe = self.expect_type(&l, id, &["ORIENTED_EDGE"], 1)?;
                 let orientation = oe.boolean(4, "orientation")?;
@@ -975,6 +933,7 @@ impl<'e, 'a> Resolver<'e, 'a> {
             outer: b.rec.name == "FACE_OUTER_BOUND",
             orientation,
             edges,
+            vertex,
         })
     }
 
