@@ -146,22 +146,14 @@ fn cylinder_face_with_arcs_and_lines() {
         step_support::real(r)
     ));
     let (u0, u1, v1) = (0.3, 2.0, 3.0);
-    let vs: Vec<u64> = [at(u0, 0.0), at(u1, 0.0), at(u1, v1), at(u0, v1)]
-        .iter()
-        .map(|&p| w.vertex(p))
-        .collect();
     let bottom_ax = w.axis(o, zd, xd);
     let bottom = w.circle(bottom_ax, r);
     let top_ax = w.axis(o + v1 * z, zd, xd);
     let top = w.circle(top_ax, r);
     let l1 = w.line(at(u1, 0.0), z);
     let l0 = w.line(at(u0, 0.0), z);
-    let e0 = w.edge(vs[0], vs[1], bottom, true);
-    let e1 = w.edge(vs[1], vs[2], l1, true);
-    let e2 = w.edge(vs[3], vs[2], top, true);
-    let e3 = w.edge(vs[0], vs[3], l0, true);
-    let b = w.bound(&[(e0, true), (e1, true), (e2, false), (e3, false)], true);
-    w.face(&[b], cyl);
+    let corners = [at(u0, 0.0), at(u1, 0.0), at(u1, v1), at(u0, v1)];
+    w.rect_face(cyl, corners, [bottom, l1, top, l0]);
     let s = only_surface(&w.finish());
     assert!(worst_error(&s, at, r) <= 1e-12);
     let (lo, hi) = mapped_domain(&s);
@@ -202,7 +194,7 @@ fn cylinder_seam_face_with_pcurves_spans_the_whole_turn() {
     let eb = w.edge(v0, v0, bottom, true);
     let et = w.edge(v1, v1, top, true);
     let es = w.edge(v0, v1, seam, true);
-    let b = w.bound(&[(eb, true), (es, true), (et, false), (es, false)], true);
+    let b = w.quad_bound(eb, es, et, es);
     w.face(&[b], cyl);
     let m = read(&w.finish());
     assert_eq!(m.report.projected_edges, 2, "the circles have no pcurves");
@@ -316,22 +308,17 @@ fn cone_sphere_and_torus_faces_match_their_definitions() {
                 w.circle(a, small)
             }
         };
-        let vs: Vec<u64> = [def(u0, v0), def(u1, v0), def(u1, v1), def(u0, v1)]
-            .iter()
-            .map(|&p| w.vertex(p))
-            .collect();
-        let (c0, c1, c2, c3) = (
+        let curves = [
             iso_v(&mut w, v0),
             iso_u(&mut w, u1),
             iso_v(&mut w, v1),
             iso_u(&mut w, u0),
+        ];
+        w.rect_face(
+            surf,
+            [def(u0, v0), def(u1, v0), def(u1, v1), def(u0, v1)],
+            curves,
         );
-        let e0 = w.edge(vs[0], vs[1], c0, true);
-        let e1 = w.edge(vs[1], vs[2], c1, true);
-        let e2 = w.edge(vs[3], vs[2], c2, true);
-        let e3 = w.edge(vs[0], vs[3], c3, true);
-        let b = w.bound(&[(e0, true), (e1, true), (e2, false), (e3, false)], true);
-        w.face(&[b], surf);
         let m = read(&w.finish());
         assert!(
             m.report.failed_faces.is_empty(),
@@ -386,17 +373,11 @@ fn revolution_and_extrusion_faces_match_their_definitions() {
     let a1 = w.add(format!("AXIS1_PLACEMENT('',#{axis_p},#{axis_d})"));
     let surf = w.add(format!("SURFACE_OF_REVOLUTION('',#{c0},#{a1})"));
     let corners = [rev(0.0, 0.0), rev(u1, 0.0), rev(u1, 1.0), rev(0.0, 1.0)];
-    let vs: Vec<u64> = corners.iter().map(|&p| w.vertex(p)).collect();
     let low_ax = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
     let low = w.circle(low_ax, 1.0);
     let high_ax = w.axis(DVec3::new(0.0, 0.0, 2.0), DVec3::Z, DVec3::X);
     let high = w.circle(high_ax, 1.5);
-    let e0 = w.edge(vs[0], vs[1], low, true);
-    let e1 = w.edge(vs[1], vs[2], c1, true);
-    let e2 = w.edge(vs[3], vs[2], high, true);
-    let e3 = w.edge(vs[0], vs[3], c0, true);
-    let b = w.bound(&[(e0, true), (e1, true), (e2, false), (e3, false)], true);
-    w.face(&[b], surf);
+    w.rect_face(surf, corners, [low, c1, high, c0]);
     let s = only_surface(&w.finish());
     let err = worst_error(&s, rev, 2.0);
     assert!(err <= 1e-12, "revolution: relative error {err}");
@@ -435,15 +416,9 @@ fn revolution_and_extrusion_faces_match_their_definitions() {
         step_support::real(b_axis)
     ));
     let corners = [ext(t0, 0.0), ext(t1, 0.0), ext(t1, 1.0), ext(t0, 1.0)];
-    let vs: Vec<u64> = corners.iter().map(|&p| w.vertex(p)).collect();
     let l1 = w.line(corners[1], d);
     let l0 = w.line(corners[0], d);
-    let e0 = w.edge(vs[0], vs[1], trimmed, true);
-    let e1 = w.edge(vs[1], vs[2], l1, true);
-    let e2 = w.edge(vs[3], vs[2], e_top, true);
-    let e3 = w.edge(vs[0], vs[3], l0, true);
-    let bd = w.bound(&[(e0, true), (e1, true), (e2, false), (e3, false)], true);
-    w.face(&[bd], surf);
+    w.rect_face(surf, corners, [trimmed, l1, e_top, l0]);
     let s = only_surface(&w.finish());
     let err = worst_error(&s, ext, 2.0);
     assert!(err <= 1e-12, "extrusion: relative error {err}");
@@ -703,5 +678,69 @@ fn styled_item_colours_become_materials() {
     assert!(
         b.max.x <= 1.0 + 1e-12,
         "the coloured face is the first square"
+    );
+}
+
+/// Two occurrences of one part in an assembly (NEXT_ASSEMBLY_USAGE_OCCURRENCE,
+/// CONTEXT_DEPENDENT_SHAPE_REPRESENTATION, ITEM_DEFINED_TRANSFORMATION): flattened into
+/// two placed copies.
+#[test]
+fn assembly_occurrences_are_flattened_with_their_placements() {
+    let mut w = StepWriter::default();
+    let ax = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
+    let plane = w.add(format!("PLANE('',#{ax})"));
+    let sq = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
+    let b = w.polygon_bound(&sq, true);
+    let face = w.face(&[b], plane);
+    let shell = w.add(format!("OPEN_SHELL('',(#{face}))"));
+    let model = w.add(format!("SHELL_BASED_SURFACE_MODEL('',(#{shell}))"));
+    let mm = w.add("(LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.))");
+    let ctx = w.add(format!(
+        "(GEOMETRIC_REPRESENTATION_CONTEXT(3) GLOBAL_UNIT_ASSIGNED_CONTEXT((#{mm})) REPRESENTATION_CONTEXT('',''))"
+    ));
+    let part_origin = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
+    let part = w.add(format!(
+        "MANIFOLD_SURFACE_SHAPE_REPRESENTATION('part',(#{part_origin},#{model}),#{ctx})"
+    ));
+    let asm_origin = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
+    let p1 = w.axis(DVec3::new(10.0, 0.0, 0.0), DVec3::Z, DVec3::X);
+    let p2 = w.axis(DVec3::new(0.0, 5.0, 0.0), DVec3::Z, DVec3::Y);
+    let asm = w.add(format!(
+        "SHAPE_REPRESENTATION('asm',(#{asm_origin},#{p1},#{p2}),#{ctx})"
+    ));
+    let pd_asm = w.add("PRODUCT_DEFINITION('asm','',#0,#0)");
+    let pd_part = w.add("PRODUCT_DEFINITION('part','',#0,#0)");
+    for (k, p) in [p1, p2].into_iter().enumerate() {
+        let idt = w.add(format!(
+            "ITEM_DEFINED_TRANSFORMATION('','',#{part_origin},#{p})"
+        ));
+        let rr = w.add(format!(
+            "(REPRESENTATION_RELATIONSHIP('','',#{part},#{asm}) REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION(#{idt}) SHAPE_REPRESENTATION_RELATIONSHIP())"
+        ));
+        let nauo = w.add(format!(
+            "NEXT_ASSEMBLY_USAGE_OCCURRENCE('{k}','','',#{pd_asm},#{pd_part},$)"
+        ));
+        let pds = w.add(format!("PRODUCT_DEFINITION_SHAPE('','',#{nauo})"));
+        w.add(format!(
+            "CONTEXT_DEPENDENT_SHAPE_REPRESENTATION(#{rr},#{pds})"
+        ));
+    }
+    let m = read(&w.text());
+    assert_eq!(m.report.occurrences, 2);
+    assert_eq!(m.objects.len(), 2);
+    let boxes: Vec<_> = m.objects.iter().map(|o| o.bounds()).collect();
+    let near = |a: DVec3, b: DVec3| (a - b).length() < 1e-12;
+    assert!(
+        near(boxes[0].min, DVec3::new(10.0, 0.0, 0.0))
+            && near(boxes[0].max, DVec3::new(11.0, 1.0, 0.0)),
+        "{:?}",
+        boxes[0]
+    );
+    // The second placement turns x onto y: the square [0,1]² becomes [-1,0] × [0,1].
+    assert!(
+        near(boxes[1].min, DVec3::new(-1.0, 5.0, 0.0))
+            && near(boxes[1].max, DVec3::new(0.0, 6.0, 0.0)),
+        "{:?}",
+        boxes[1]
     );
 }

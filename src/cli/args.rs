@@ -141,7 +141,9 @@ pub struct TeapotsArgs {
 
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// Scene (.ron) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb).
+    /// Scene (.ron) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb, .step, .stp). For a
+    /// STEP file, also its schema, units, faces converted or not, projected edges and the
+    /// largest projection error, and unsupported entities by type.
     pub scene: PathBuf,
     /// Print JSON instead of text.
     #[arg(long)]
@@ -150,7 +152,7 @@ pub struct InfoArgs {
 
 #[derive(Debug, Args)]
 pub struct ImportArgs {
-    /// Input scene or geometry file.
+    /// Input scene or geometry file (any SCENE input, STEP included).
     pub input: PathBuf,
     /// Output: .ron (scene, geometry inline), .bpt (non-rational patches) or .obj
     /// (free-form Bézier patches).

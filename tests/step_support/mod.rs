@@ -126,6 +126,28 @@ impl StepWriter {
         self.add(format!("{kind}('',#{l},.T.)"))
     }
 
+    /// The outer bound of a face between iso-curves: `low` and `right` forwards, `high`
+    /// and `left` backwards (the edges of a parameter rectangle all running in +u or +v).
+    /// A seam face passes its seam edge as both `right` and `left`.
+    pub fn quad_bound(&mut self, low: u64, right: u64, high: u64, left: u64) -> u64 {
+        self.bound(
+            &[(low, true), (right, true), (high, false), (left, false)],
+            true,
+        )
+    }
+
+    /// A face over the parameter rectangle with `corners` (u0v0, u1v0, u1v1, u0v1) whose
+    /// sides lie on `curves` (low v, high u, high v, low u), each running in +u or +v.
+    pub fn rect_face(&mut self, surface: u64, corners: [DVec3; 4], curves: [u64; 4]) -> u64 {
+        let vs: Vec<u64> = corners.iter().map(|&p| self.vertex(p)).collect();
+        let e0 = self.edge(vs[0], vs[1], curves[0], true);
+        let e1 = self.edge(vs[1], vs[2], curves[1], true);
+        let e2 = self.edge(vs[3], vs[2], curves[2], true);
+        let e3 = self.edge(vs[0], vs[3], curves[3], true);
+        let b = self.quad_bound(e0, e1, e2, e3);
+        self.face(&[b], surface)
+    }
+
     pub fn face(&mut self, bounds: &[u64], surface: u64) -> u64 {
         let f = self.add(format!("ADVANCED_FACE('',{},#{surface},.T.)", refs(bounds)));
         self.faces.push(f);
@@ -338,15 +360,7 @@ fn bracket_faces(w: &mut StepWriter, o: DVec3) {
     // The meridian circle's frame has axis −y and x = +x, so its y is (−y) × x = z:
     // angle π/2 is the top vertex and π the inner one.
     let e_seam = w.edge(v_top, v_in, seam_c, true);
-    let b = w.bound(
-        &[
-            (e_top, true),
-            (e_seam, true),
-            (e_in, false),
-            (e_seam, false),
-        ],
-        true,
-    );
+    let b = w.quad_bound(e_top, e_seam, e_in, e_seam);
     w.face(&[b], torus);
     // Hole wall: cylinder r = a from z = 0 to 1 − f, seam at angle 0 with pcurves.
     let cax = w.axis(o, z, x);
@@ -368,15 +382,7 @@ fn bracket_faces(w: &mut StepWriter, o: DVec3) {
     ));
     let e_wall = w.edge(v_low, v_in, seam, true);
     let e_in2 = w.edge(v_in, v_in, c_in, true);
-    let b = w.bound(
-        &[
-            (e_low, true),
-            (e_wall, true),
-            (e_in2, false),
-            (e_wall, false),
-        ],
-        true,
-    );
+    let b = w.quad_bound(e_low, e_wall, e_in2, e_wall);
     w.face(&[b], cyl);
     // Bottom: a flat bicubic B-spline over the square, knots with an interior break.
     let n = 5;

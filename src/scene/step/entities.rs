@@ -512,12 +512,23 @@ impl<'e, 'a> Resolver<'e, 'a> {
     }
 
     pub fn curve_by_id(&self, from: &Rec, id: u64) -> Result<Rc<Curve>, ParseError> {
-        if let Some(c) = self.curves.borrow().get(&id) {
+        self.cached(&self.curves, from, id, |inst| self.read_curve(inst))
+    }
+
+    /// Entity `id` from `cache`, or read by `read` one level deeper and kept.
+    fn cached<T>(
+        &self,
+        cache: &RefCell<HashMap<u64, Rc<T>>>,
+        from: &Rec,
+        id: u64,
+        read: impl FnOnce(&'e Instance<'a>) -> Result<T, ParseError>,
+    ) -> Result<Rc<T>, ParseError> {
+        if let Some(c) = cache.borrow().get(&id) {
             return Ok(c.clone());
         }
         let inst = self.instance(from, id)?;
-        let c = Rc::new(self.deeper(from, || self.read_curve(inst))?);
-        self.curves.borrow_mut().insert(id, c.clone());
+        let c = Rc::new(self.deeper(from, || read(inst))?);
+        cache.borrow_mut().insert(id, c.clone());
         Ok(c)
     }
 
@@ -702,13 +713,7 @@ impl<'e, 'a> Resolver<'e, 'a> {
 
     /// Any supported surface, cached by id (faces share their surfaces with pcurves).
     pub fn surface_by_id(&self, from: &Rec, id: u64) -> Result<Rc<SurfaceDef>, ParseError> {
-        if let Some(s) = self.surfaces.borrow().get(&id) {
-            return Ok(s.clone());
-        }
-        let inst = self.instance(from, id)?;
-        let s = Rc::new(self.deeper(from, || self.read_surface(inst))?);
-        self.surfaces.borrow_mut().insert(id, s.clone());
-        Ok(s)
+        self.cached(&self.surfaces, from, id, |inst| self.read_surface(inst))
     }
 
     fn read_surface(&self, inst: &'e Instance<'a>) -> Result<SurfaceDef, ParseError> {
