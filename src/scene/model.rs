@@ -174,6 +174,8 @@ pub struct Scene {
     pub ambient: f32,
     /// Longest path of reflection and refraction bounces (the primary ray is depth 1).
     pub max_depth: u32,
+    /// Samples per pixel, unless `render --spp` says otherwise (`None`: one).
+    pub samples: Option<u32>,
     pub lights: Vec<Light>,
     pub materials: Vec<Material>,
     pub objects: Vec<Object>,
@@ -206,6 +208,7 @@ impl Scene {
             background: Vec3::new(0.05, 0.05, 0.08),
             ambient: DEFAULT_AMBIENT,
             max_depth: DEFAULT_MAX_DEPTH,
+            samples: None,
             lights: Vec::new(),
             materials: vec![Material::default_named("default")],
             objects,
