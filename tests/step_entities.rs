@@ -20,14 +20,48 @@ fn read(text: &str) -> StepModel {
     read_step_str(Path::new("test.step"), text).unwrap_or_else(|e| panic!("{e}\n{text}"))
 }
 
+/// The surfaces of the model, each of whose loops is checked to be a chain: every segment
+/// starts (at t0) where the previous one ends (at t1), and the last ends at the first's
+/// start, as `geom::trim` reads loops (a gap would be bridged by a straight piece there).
 fn surfaces(m: &StepModel) -> Vec<Surface> {
-    m.objects
+    let out: Vec<Surface> = m
+        .objects
         .iter()
         .flat_map(|o| match &o.geometry {
             Geometry::Surfaces(s) => s.clone(),
             Geometry::Mesh(_) => Vec::new(),
         })
-        .collect()
+        .collect();
+    for s in &out {
+        for l in &s.trims {
+            let ends: Vec<(DVec2, DVec2)> = l
+                .segments
+                .iter()
+                .map(|seg| {
+                    let c = as_curve(&seg.curve);
+                    (c.eval(seg.t0).truncate(), c.eval(seg.t1).truncate())
+                })
+                .collect();
+            for k in 0..ends.len() {
+                let next = ends[(k + 1) % ends.len()].0;
+                let gap = (ends[k].1 - next).length();
+                assert!(gap < 1e-9, "segment {k} ends {} from the next start", gap);
+            }
+        }
+    }
+    out
+}
+
+fn as_curve(c: &patchtrace::geom::trim::ParamCurve) -> NurbsCurve {
+    NurbsCurve {
+        degree: c.degree,
+        knots: c.knots.clone(),
+        points: c
+            .points
+            .iter()
+            .map(|p| DVec4::new(p.x, p.y, 0.0, p.z))
+            .collect(),
+    }
 }
 
 fn only_surface(text: &str) -> Surface {
@@ -77,16 +111,7 @@ fn mapped_domain(s: &Surface) -> (DVec2, DVec2) {
 fn loop_points(l: &TrimLoop) -> Vec<DVec2> {
     let mut out = Vec::new();
     for seg in &l.segments {
-        let c = NurbsCurve {
-            degree: seg.curve.degree,
-            knots: seg.curve.knots.clone(),
-            points: seg
-                .curve
-                .points
-                .iter()
-                .map(|p| DVec4::new(p.x, p.y, 0.0, p.z))
-                .collect(),
-        };
+        let c = as_curve(&seg.curve);
         for k in 0..=32 {
             out.push(
                 c.eval(seg.t0 + (seg.t1 - seg.t0) * k as f64 / 32.0)

@@ -20,6 +20,9 @@ use crate::scene::error::ParseError;
 
 /// Deepest assembly nesting followed; deeper (or cyclic) structure is refused.
 const MAX_NESTING: usize = 32;
+/// Most occurrences flattened: nesting multiplies them, and a file of a few kilobytes can
+/// otherwise ask for billions of copies.
+const MAX_OCCURRENCES: usize = 100_000;
 
 /// One placed copy of a representation's geometry items.
 #[derive(Clone, Debug)]
@@ -200,6 +203,14 @@ pub fn occurrences(
                 format!(
                     "assembly structure nests deeper than {MAX_NESTING} (a cycle through #{p}?)"
                 ),
+            ));
+        }
+        if out.len() > MAX_OCCURRENCES {
+            return Err(ParseError::new(
+                res.path,
+                1,
+                1,
+                format!("the assembly flattens into more than {MAX_OCCURRENCES} occurrences"),
             ));
         }
         for &rep in &members[&p] {

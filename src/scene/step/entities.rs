@@ -332,7 +332,7 @@ fn expand_knots(r: &Rec, mult: &Param, knots: &Param) -> Result<Vec<f64>, ParseE
 /// The knots ISO 10303-42 implies for a BEZIER_CURVE/SURFACE of `count` points: 0 and the
 /// last breakpoint repeated `degree + 1` times, the integers between `degree` times.
 fn bezier_knots(degree: usize, count: usize) -> Option<Vec<f64>> {
-    if degree == 0 || count < degree + 1 || (count - 1) % degree != 0 {
+    if degree == 0 || count < degree + 1 || !(count - 1).is_multiple_of(degree) {
         return None;
     }
     let pieces = (count - 1) / degree;
@@ -698,7 +698,10 @@ impl<'e, 'a> Resolver<'e, 'a> {
         };
         crate::geom::nurbs::knots::validate(degree, &knots, points.len())
             .map_err(|e| base.error(e.to_string()))?;
-        if let Some(k) = weights.iter().position(|w| !(*w > 0.0)) {
+        if let Some(k) = weights
+            .iter()
+            .position(|w| w.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
+        {
             return Err(base.error(format!(
                 "weight {k} is {}; weights must be positive",
                 weights[k]
@@ -731,7 +734,7 @@ impl<'e, 'a> Resolver<'e, 'a> {
             }),
             "CONICAL_SURFACE" => {
                 let semi_angle = r.real(3, "a semi-angle")? * self.angle_unit;
-                if !(semi_angle.abs() < std::f64::consts::FRAC_PI_2) {
+                if semi_angle.is_nan() || semi_angle.abs() >= std::f64::consts::FRAC_PI_2 {
                     return Err(r.error(format!(
                         "expected a semi-angle below 90°, found {} rad",
                         semi_angle

@@ -95,8 +95,10 @@ impl Curve {
             } => {
                 let (mut a, mut b) = if *sense { (*t0, *t1) } else { (*t1, *t0) };
                 if let Some(p) = basis.period() {
-                    while b <= a {
-                        b += p;
+                    // Not a loop adding p: beyond 2^53 · p an addition leaves b unchanged.
+                    b = a + (b - a).rem_euclid(p);
+                    if b <= a {
+                        b = a + p;
                     }
                 } else if b < a {
                     std::mem::swap(&mut a, &mut b);

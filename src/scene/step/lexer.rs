@@ -264,7 +264,7 @@ fn word_end(bytes: &[u8], from: usize) -> usize {
 }
 
 fn hex_chars(hex: &str, width: usize) -> Result<String, String> {
-    if hex.len() % width != 0 || !hex.bytes().all(|c| c.is_ascii_hexdigit()) {
+    if !hex.len().is_multiple_of(width) || !hex.bytes().all(|c| c.is_ascii_hexdigit()) {
         return Err(format!(
             "expected groups of {width} hex digits in an escape, found `{hex}`"
         ));

@@ -22,7 +22,7 @@ pub mod style;
 pub mod topology;
 pub mod units;
 
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
 use glam::{DAffine3, DVec3};
@@ -231,21 +231,21 @@ pub fn read_step_str(path: &Path, src: &str) -> Result<StepModel, ParseError> {
     let mut hi = DVec3::splat(f64::NEG_INFINITY);
     for inst in &ex.instances {
         let r = &inst.records[0];
-        if r.name == "CARTESIAN_POINT" {
-            if let Some(records::Value::List(c)) = r.params.get(1).map(|p| &p.value) {
-                let v: Vec<f64> = c
-                    .iter()
-                    .filter_map(|p| match p.value {
-                        records::Value::Real(x) => Some(x),
-                        records::Value::Integer(i) => Some(i as f64),
-                        _ => None,
-                    })
-                    .collect();
-                if v.len() == 3 {
-                    let p = DVec3::new(v[0], v[1], v[2]);
-                    lo = lo.min(p);
-                    hi = hi.max(p);
-                }
+        if r.name == "CARTESIAN_POINT"
+            && let Some(records::Value::List(c)) = r.params.get(1).map(|p| &p.value)
+        {
+            let v: Vec<f64> = c
+                .iter()
+                .filter_map(|p| match p.value {
+                    records::Value::Real(x) => Some(x),
+                    records::Value::Integer(i) => Some(i as f64),
+                    _ => None,
+                })
+                .collect();
+            if v.len() == 3 {
+                let p = DVec3::new(v[0], v[1], v[2]);
+                lo = lo.min(p);
+                hi = hi.max(p);
             }
         }
     }
@@ -258,19 +258,14 @@ pub fn read_step_str(path: &Path, src: &str) -> Result<StepModel, ParseError> {
     let mut converted: HashMap<u64, Option<Surface>> = HashMap::new();
     let mut palette: Vec<Colour> = Vec::new();
     let mut groups: BTreeMap<(usize, usize), Vec<Surface>> = BTreeMap::new();
-    let mut failed: HashSet<u64> = HashSet::new();
     for (k, occ) in occurrences.iter().enumerate() {
         let mut faces = Vec::new();
         for &item in &occ.items {
             item_faces(&res, item, &colours, None, &mut faces, 0)?;
         }
         for (fid, colour) in faces {
-            if !converted.contains_key(&fid) {
-                let surface = convert_one(&res, fid, size, &mut report, &mut unsupported)?;
-                if surface.is_none() {
-                    failed.insert(fid);
-                }
-                converted.insert(fid, surface);
+            if let std::collections::hash_map::Entry::Vacant(slot) = converted.entry(fid) {
+                slot.insert(convert_one(&res, fid, size, &mut report, &mut unsupported)?);
             }
             let Some(surface) = &converted[&fid] else {
                 continue;

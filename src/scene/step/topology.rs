@@ -57,6 +57,8 @@ pub struct FaceOutcome {
 struct Piece {
     seg: TrimSegment,
     reversed: bool,
+    /// Where the traversal starts and ends, evaluated once.
+    ends: [DVec2; 2],
 }
 
 /// The parameter-plane curve as a NURBS curve in the z = 0 plane, to evaluate it.
@@ -99,24 +101,22 @@ fn polyline(points: &[DVec2]) -> TrimSegment {
 }
 
 impl Piece {
-    fn at(&self, t: f64) -> DVec2 {
-        as_nurbs(&self.seg.curve).eval(t).truncate()
+    fn new(seg: TrimSegment, reversed: bool) -> Piece {
+        let c = as_nurbs(&seg.curve);
+        let (a, b) = (c.eval(seg.t0).truncate(), c.eval(seg.t1).truncate());
+        Piece {
+            ends: if reversed { [b, a] } else { [a, b] },
+            seg,
+            reversed,
+        }
     }
 
     fn start(&self) -> DVec2 {
-        self.at(if self.reversed {
-            self.seg.t1
-        } else {
-            self.seg.t0
-        })
+        self.ends[0]
     }
 
     fn end(&self) -> DVec2 {
-        self.at(if self.reversed {
-            self.seg.t0
-        } else {
-            self.seg.t1
-        })
+        self.ends[1]
     }
 
     /// Moves the piece by `d`, exactly: each homogeneous point gains `w · d`.
@@ -125,6 +125,7 @@ impl Piece {
             p.x += p.z * d.x;
             p.y += p.z * d.y;
         }
+        self.ends = self.ends.map(|e| e + d);
     }
 
     /// Points along the piece, for its extent.
@@ -340,7 +341,7 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
             if !(ta.is_finite() && tb.is_finite() && ta < tb) {
                 return Err(format!("edge #{} has an empty parameter range", e.id));
             }
-            if !candidates.contains_key(&e.id) {
+            if let std::collections::hash_map::Entry::Vacant(slot) = candidates.entry(e.id) {
                 let c3 = e.curve.space_curve();
                 let mut list = Vec::new();
                 if let Curve::OnSurface { pcurves, .. } = &*e.curve {
@@ -358,16 +359,13 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
                     projected_edges += 1;
                     list.push(polyline(&points));
                 }
-                candidates.insert(e.id, list);
+                slot.insert(list);
             }
             let list = &candidates[&e.id];
             let reversed = oe.orientation != e.same_sense;
             let prev_end = pieces.last().map(Piece::end);
             let placed = |k: usize| -> Piece {
-                let mut p = Piece {
-                    seg: list[k].clone(),
-                    reversed,
-                };
+                let mut p = Piece::new(list[k].clone(), reversed);
                 if let Some(end) = prev_end {
                     let s = p.start();
                     let du = if dom.collapsed_u(end) {
@@ -396,13 +394,10 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
             let piece = placed(k);
             // A gap in the domain where the 3D loop is continuous: a pole or apex, or a
             // file's tolerance; bridge it so the loop stays closed.
-            if let Some(end) = prev_end {
-                if piece.start().distance(end) > 1e-9 * (1.0 + end.length()) {
-                    pieces.push(Piece {
-                        seg: polyline(&[end, piece.start()]),
-                        reversed: false,
-                    });
-                }
+            if let Some(end) = prev_end
+                && piece.start().distance(end) > 1e-9 * (1.0 + end.length())
+            {
+                pieces.push(Piece::new(polyline(&[end, piece.start()]), false));
             }
             pieces.push(piece);
         }
@@ -423,10 +418,7 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
             })
         });
         if winds.is_none() && gap.length() > 1e-9 * (1.0 + last.length()) {
-            pieces.push(Piece {
-                seg: polyline(&[last, first]),
-                reversed: false,
-            });
+            pieces.push(Piece::new(polyline(&[last, first]), false));
         }
         let mut lo = f64::INFINITY;
         let mut hi = f64::NEG_INFINITY;
@@ -483,14 +475,23 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
             a[other] = far;
             let mut b = first;
             b[other] = far;
-            pieces.push(Piece {
-                seg: polyline(&[last, a, b, first]),
-                reversed: false,
-            });
+            pieces.push(Piece::new(polyline(&[last, a, b, first]), false));
         }
         trims.push(TrimLoop {
             hole: k > 0,
-            segments: pieces.into_iter().map(|p| p.seg).collect(),
+            // A segment runs from t0 to t1 in either order (`geom::trim`): reversed
+            // pieces swap them, so each segment starts where the previous one ended.
+            segments: pieces
+                .into_iter()
+                .map(|p| match p.reversed {
+                    false => p.seg,
+                    true => TrimSegment {
+                        t0: p.seg.t1,
+                        t1: p.seg.t0,
+                        curve: p.seg.curve,
+                    },
+                })
+                .collect(),
         });
     }
     Ok(FaceOutcome {

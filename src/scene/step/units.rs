@@ -144,10 +144,10 @@ pub fn context_units(res: &Resolver, ctx: u64) -> Units {
             if let Some(size) = unit_size(res, u, 0) {
                 units.length = size;
             }
-        } else if u.record("PLANE_ANGLE_UNIT").is_some() {
-            if let Some(size) = unit_size(res, u, 0) {
-                units.angle = size;
-            }
+        } else if u.record("PLANE_ANGLE_UNIT").is_some()
+            && let Some(size) = unit_size(res, u, 0)
+        {
+            units.angle = size;
         }
     }
     units
