@@ -29,7 +29,7 @@ fn surfaces(m: &StepModel) -> Vec<Surface> {
         .iter()
         .flat_map(|o| match &o.geometry {
             Geometry::Surfaces(s) => s.clone(),
-            Geometry::Mesh(_) => Vec::new(),
+            _ => Vec::new(),
         })
         .collect();
     for s in &out {

@@ -375,7 +375,7 @@ pub fn load_geometry(path: &Path) -> Result<Geometry, LoadError> {
         .into_iter()
         .flat_map(|o| match o.geometry {
             Geometry::Surfaces(s) => s,
-            Geometry::Mesh(_) => Vec::new(),
+            _ => Vec::new(),
         })
         .collect();
     Ok(Geometry::Surfaces(surfaces))
