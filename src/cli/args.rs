@@ -149,10 +149,9 @@ pub struct TeapotsArgs {
 
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// Scene (.ron) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb, .igs, .iges). For
-    /// IGES also prints the file's units, the entities not read (by type), surfaces that
-    /// could not be converted, and the largest error of trim curves projected from model
-    /// space.
+    /// Scene (.ron) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb, .igs, .iges, .step,
+    /// .stp). For IGES and STEP files also the units, what was not read (by type),
+    /// surfaces not converted, and the largest error of projected trim curves.
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
@@ -163,7 +162,7 @@ pub struct InfoArgs {
 
 #[derive(Debug, Args)]
 pub struct ImportArgs {
-    /// Input scene or geometry file (IGES 5.3 `.igs`/`.iges` included).
+    /// Input scene or geometry file (any SCENE input, IGES and STEP included).
     pub input: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,

@@ -5,7 +5,7 @@ use std::path::Path;
 use super::error::LoadError;
 use super::model::Material;
 use super::model::{Geometry, Object, Scene, Surface};
-use super::{bpt, cage, iges, mesh, obj, pbrt, ron_format};
+use super::{bpt, cage, iges, mesh, obj, pbrt, ron_format, step};
 
 /// The kinds of input file we read, by extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -16,6 +16,7 @@ pub enum InputKind {
     Pbrt,
     Gltf,
     Iges,
+    Step,
 }
 
 impl InputKind {
@@ -28,6 +29,7 @@ impl InputKind {
             "pbrt" => InputKind::Pbrt,
             "gltf" | "glb" => InputKind::Gltf,
             "igs" | "iges" => InputKind::Iges,
+            "step" | "stp" => InputKind::Step,
             _ => return None,
         })
     }
@@ -36,7 +38,7 @@ impl InputKind {
 fn unknown_kind(path: &Path) -> LoadError {
     LoadError::invalid(
         path,
-        "unknown file type: expected .ron (scene), .bpt, .obj, .pbrt, .gltf, .glb, .igs or .iges",
+        "unknown file type: expected .ron (scene), .bpt, .obj, .pbrt, .gltf, .glb, .igs, .iges, .step or .stp",
     )
 }
 
@@ -69,6 +71,7 @@ pub fn load_geometry(path: &Path) -> Result<Geometry, LoadError> {
                 .map(|d| d.surface)
                 .collect(),
         )),
+        InputKind::Step => step::load_geometry(path),
         InputKind::Ron => Err(LoadError::invalid(
             path,
             "a scene cannot be used as geometry; reference its geometry files instead",
@@ -102,6 +105,7 @@ pub fn load_subdivision(path: &Path) -> Result<Geometry, LoadError> {
         InputKind::Pbrt => Err(refuse("a pbrt file")),
         InputKind::Ron => Err(refuse("a RON scene")),
         InputKind::Iges => Err(refuse("an IGES file")),
+        InputKind::Step => Err(refuse("a STEP file")),
     }
 }
 
@@ -120,19 +124,36 @@ pub fn load_scene(path: &Path) -> Result<Scene, LoadError> {
 
 /// [`load_scene`] with options for bare geometry.
 pub fn load_scene_with(path: &Path, options: LoadOptions) -> Result<Scene, LoadError> {
-    let scene = if options.subdivide {
+    Ok(load_scene_noted(path, options)?.0)
+}
+
+/// [`load_scene_with`], with what the reader noted about the file beyond the scene (a
+/// STEP file's units, unsupported entities, faces left out), one line each, for `info`.
+pub fn load_scene_noted(
+    path: &Path,
+    options: LoadOptions,
+) -> Result<(Scene, Vec<String>), LoadError> {
+    let (scene, notes) = if options.subdivide {
         if InputKind::of(path) == Some(InputKind::Ron) {
             return Err(LoadError::invalid(
                 path,
                 "--subdivide applies to bare mesh files; in a RON scene write `geometry: Subdivision(File(\"cage.obj\"))`",
             ));
         }
-        bare_scene(path, load_subdivision(path)?)
+        (bare_scene(path, load_subdivision(path)?), Vec::new())
+    } else if InputKind::of(path) == Some(InputKind::Step) {
+        let model = step::read_step(path)?;
+        if let Some(w) = model.report.warning(path) {
+            eprintln!("{w}");
+        }
+        let mut scene = Scene::framing(model.objects);
+        scene.materials = model.materials;
+        (scene, model.report.lines())
     } else {
-        read_any_scene(path)?
+        (read_any_scene(path)?, Vec::new())
     };
     check_f32_range(path, &scene)?;
-    Ok(scene)
+    Ok((scene, notes))
 }
 
 /// Smallest object extent the renderer accepts: 2^-60 ≈ 8.7e-19. Shading squares
