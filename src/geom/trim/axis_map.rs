@@ -1,35 +1,4 @@
-//! Trimming loops in a surface's parameter domain (OBJ `trim` / `hole` with `curv2`,
-//! IGES 144/142, STEP face bounds). They are parsed and kept; the kernels do not evaluate
-//! them yet (Dammertz §2.6).
-
-use glam::DVec3;
-
-/// A planar parameter-space curve (OBJ `curv2`) as a B-spline: homogeneous premultiplied
-/// points `(w u, w v, w)` (w = 1 for non-rational) and a knot vector of
-/// `points.len() + degree + 1` values. A piecewise Bézier curve is stored as the B-spline
-/// with the same breakpoints (end knots repeated `degree + 1` times, interior ones
-/// `degree` times), which is the same curve.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ParamCurve {
-    pub degree: usize,
-    pub knots: Vec<f64>,
-    pub points: Vec<DVec3>,
-}
-
-/// A piece of a loop: a parameter curve restricted to `[t0, t1]`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct TrimSegment {
-    pub t0: f64,
-    pub t1: f64,
-    pub curve: ParamCurve,
-}
-
-/// A closed loop: the outer boundary (`trim`) or a hole (`hole`).
-#[derive(Clone, Debug, PartialEq)]
-pub struct TrimLoop {
-    pub hole: bool,
-    pub segments: Vec<TrimSegment>,
-}
+//! The map from a NURBS parameter to the parameter trims are written in.
 
 /// How one parameter of a surface's NURBS form maps to the parameter its trim loops are
 /// written in. CAD formats give trims of analytic surfaces (IGES 120, 190–198; STEP
@@ -72,6 +41,7 @@ impl AxisMap {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::DVec3;
 
     #[test]
     fn arc_map_inverts_the_rational_quadratic_arc() {
