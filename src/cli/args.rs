@@ -276,6 +276,10 @@ pub struct KernelArgs {
     /// `--kernel cached`.
     #[arg(long, value_name = "LEVELS")]
     pub cache_depth: Option<u8>,
+    /// Render the surfaces untrimmed: read trim loops and drop them, to see what trimming
+    /// removes (the effect line says "trims ignored").
+    #[arg(long)]
+    pub ignore_trims: bool,
     /// Load the BVH from this file (written by `patchtrace bvh`) instead of building it.
     #[arg(long, value_name = "FILE")]
     pub bvh: Option<PathBuf>,

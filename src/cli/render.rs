@@ -48,7 +48,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     let scene = &mut prepared.scene;
     args.size.apply(&mut scene.camera)?;
     let precision = precision(&args.kernel, &scene.camera)?;
-    let plan = EffectPlan::for_scene(scene);
+    let plan = EffectPlan {
+        trims: prepared.trims,
+        ..EffectPlan::for_scene(scene)
+    };
     eprintln!("{plan}");
     let integrator = Integrator {
         scene,

@@ -14,6 +14,7 @@ use crate::kernel::cached::{CachedConfig, DEFAULT_CACHE_BYTES, DEFAULT_MAX_DEPTH
 use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig, Termination};
 use crate::kernel::toth::TothConfig;
 use crate::render::camera::CameraRays;
+use crate::render::plan::TrimEffect;
 use crate::scene::{Camera, Scene, load_scene};
 
 /// The kernel path selected by the flags, or why the flags do not go together; `camera`
@@ -82,6 +83,8 @@ pub struct Prepared {
     pub geometry: SceneGeometry,
     pub load_seconds: f64,
     pub prepare_seconds: f64,
+    /// The trim loops as read, and whether `--ignore-trims` dropped them.
+    pub trims: TrimEffect,
 }
 
 /// Loads the scene and prepares its geometry: builds the BVH or loads `--bvh`, or builds
@@ -92,7 +95,11 @@ pub fn prepare(scene_path: &Path, args: &KernelArgs) -> anyhow::Result<Prepared>
         "--bvh loads a BVH file, which --accel grid does not use; drop one of the two flags"
     );
     let start = Instant::now();
-    let scene = load_scene(scene_path)?;
+    let mut scene = load_scene(scene_path)?;
+    let trims = TrimEffect::of(&scene, args.ignore_trims);
+    if args.ignore_trims {
+        scene = scene.without_trims();
+    }
     let load_seconds = start.elapsed().as_secs_f64();
     let start = Instant::now();
     let geometry = match (args.accel, &args.bvh) {
@@ -107,6 +114,7 @@ pub fn prepare(scene_path: &Path, args: &KernelArgs) -> anyhow::Result<Prepared>
         geometry,
         load_seconds,
         prepare_seconds: start.elapsed().as_secs_f64(),
+        trims,
     })
 }
 

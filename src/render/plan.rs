@@ -20,6 +20,27 @@ pub struct EffectPlan {
     /// Longest ray path; 1 (primary rays only) when neither reflection nor refraction.
     pub max_depth: u32,
     pub lights: usize,
+    /// Trim loops applied (Dammertz §2.6), or ignored with `--ignore-trims`.
+    pub trims: TrimEffect,
+}
+
+/// Whether hits are tested against trim loops.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct TrimEffect {
+    /// Trim loops of the scene's surfaces.
+    pub loops: usize,
+    /// `--ignore-trims`: the loops were read and dropped.
+    pub ignored: bool,
+}
+
+impl TrimEffect {
+    /// The trims of `scene`, as `--ignore-trims` (`ignored`) leaves them.
+    pub fn of(scene: &Scene, ignored: bool) -> TrimEffect {
+        TrimEffect {
+            loops: scene.trim_loop_count(),
+            ignored,
+        }
+    }
 }
 
 impl EffectPlan {
@@ -40,6 +61,7 @@ impl EffectPlan {
             refraction,
             max_depth: if bounces { scene.max_depth.max(1) } else { 1 },
             lights: scene.lights.len(),
+            trims: TrimEffect::of(scene, false),
         }
     }
 }
@@ -62,6 +84,15 @@ impl fmt::Display for EffectPlan {
             on(self.reflection, "reflection"),
             on(self.refraction, "refraction"),
             self.max_depth
-        )
+        )?;
+        match self.trims {
+            TrimEffect { ignored: true, .. } => write!(f, ", trims ignored"),
+            TrimEffect { loops: 0, .. } => Ok(()),
+            TrimEffect { loops, .. } => write!(
+                f,
+                ", trims: {loops} loop{}",
+                if loops == 1 { "" } else { "s" }
+            ),
+        }
     }
 }

@@ -71,7 +71,28 @@ pub fn load_geometry(path: &Path) -> Result<Geometry, LoadError> {
 pub fn load_scene(path: &Path) -> Result<Scene, LoadError> {
     let scene = read_any_scene(path)?;
     check_f32_range(path, &scene)?;
+    check_trims(path, &scene)?;
     Ok(scene)
+}
+
+/// Every trim loop converts to Bézier pieces (degrees, knots, weights, ranges), checked
+/// once at load so that the renderer never meets loops it cannot apply; the error names
+/// the object and surface.
+pub fn check_trims(path: &Path, scene: &Scene) -> Result<(), LoadError> {
+    for o in &scene.objects {
+        let Geometry::Surfaces(surfaces) = &o.geometry else {
+            continue;
+        };
+        for (k, s) in surfaces.iter().enumerate() {
+            if let Err(e) = s.trim_region() {
+                return Err(LoadError::invalid(
+                    path,
+                    format!("object \"{}\", surface {k}: trim loops: {e}", o.name),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Smallest object extent the renderer accepts: 2^-60 ≈ 8.7e-19. Shading squares

@@ -6,7 +6,7 @@ use glam::{DVec3, Vec3};
 use crate::geom::BezierPatch;
 use crate::geom::bbox::DAabb;
 use crate::geom::nurbs::NurbsSurface;
-use crate::geom::trim::{AxisMap, TrimLoop};
+use crate::geom::trim::{AxisMap, Coverage, PatchTrim, TrimError, TrimLoop, TrimRegion};
 
 /// Camera per the DESIGN.md contract.
 #[derive(Clone, Debug, PartialEq)]
@@ -94,7 +94,37 @@ impl Surface {
             SurfaceGeometry::Nurbs(n) => n.transform(m),
         }
     }
+
+    /// The region the trim loops keep, `None` without loops; an error for loops that cannot
+    /// be converted (the readers check this at load, [`crate::scene::check_trims`]).
+    pub fn trim_region(&self) -> Result<Option<TrimRegion>, TrimError> {
+        TrimRegion::new(&self.trims, &self.trim_space)
+    }
+
+    /// The surface's Bézier patches in contract order, each with what its trim loops leave
+    /// of it ([`Coverage`]): a patch they cut away wholly is `Outside`.
+    pub fn trimmed_patches(&self) -> Vec<(BezierPatch, Coverage)> {
+        let patches = match &self.geometry {
+            SurfaceGeometry::Bezier(p) => vec![p.clone()],
+            SurfaceGeometry::Nurbs(n) => n.to_bezier_patches(),
+        };
+        // Loops that fail to convert were refused at load; were one to get here, the
+        // surface is drawn untrimmed rather than not at all.
+        match self.trim_region().ok().flatten() {
+            None => patches.into_iter().map(|p| (p, Coverage::Inside)).collect(),
+            Some(region) => patches
+                .into_iter()
+                .map(|p| {
+                    let coverage = region.coverage(p.domain());
+                    (p, coverage)
+                })
+                .collect(),
+        }
+    }
 }
+
+/// A patch ready for the renderer: its trim, where its loops cut it.
+pub type TrimmedPatch = (BezierPatch, Option<Box<PatchTrim>>);
 
 /// An indexed triangle mesh with optional per-vertex normals.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -141,6 +171,24 @@ impl Object {
                 .flat_map(|s| match &s.geometry {
                     SurfaceGeometry::Bezier(p) => vec![p.clone()],
                     SurfaceGeometry::Nurbs(n) => n.to_bezier_patches(),
+                })
+                .collect(),
+            Geometry::Mesh(_) => Vec::new(),
+        }
+    }
+
+    /// The object's patches in contract order with their trims; `None` for a patch its
+    /// trim loops cut away wholly (it keeps its number, as the contract numbers patches in
+    /// file order).
+    pub fn trimmed_patches(&self) -> Vec<Option<TrimmedPatch>> {
+        match &self.geometry {
+            Geometry::Surfaces(surfaces) => surfaces
+                .iter()
+                .flat_map(|s| s.trimmed_patches())
+                .map(|(p, coverage)| match coverage {
+                    Coverage::Outside => None,
+                    Coverage::Inside => Some((p, None)),
+                    Coverage::Partial(trim) => Some((p, Some(trim))),
                 })
                 .collect(),
             Geometry::Mesh(_) => Vec::new(),
@@ -231,5 +279,31 @@ impl Scene {
 
     pub fn patch_count(&self) -> usize {
         self.objects.iter().map(|o| o.bezier_patches().len()).sum()
+    }
+
+    /// The number of trim loops over all surfaces.
+    pub fn trim_loop_count(&self) -> usize {
+        self.surfaces().map(|s| s.trims.len()).sum()
+    }
+
+    /// The same scene with every trim loop removed (`--ignore-trims`: to see what trimming
+    /// removes).
+    pub fn without_trims(mut self) -> Scene {
+        for o in &mut self.objects {
+            if let Geometry::Surfaces(surfaces) = &mut o.geometry {
+                for s in surfaces {
+                    s.trims.clear();
+                }
+            }
+        }
+        self
+    }
+
+    /// Every free-form surface of every object.
+    pub fn surfaces(&self) -> impl Iterator<Item = &Surface> {
+        self.objects.iter().flat_map(|o| match &o.geometry {
+            Geometry::Surfaces(s) => s.as_slice(),
+            Geometry::Mesh(_) => &[],
+        })
     }
 }

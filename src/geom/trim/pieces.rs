@@ -140,11 +140,7 @@ pub fn loop_pieces(l: &TrimLoop) -> Result<Vec<Piece>, TrimError> {
 
 /// The Bézier pieces of `curve` over `[t0, t1]` (either order), in the direction from `t0`
 /// to `t1`'s end of the range; the range is clamped to the curve's domain.
-fn segment_pieces(
-    curve: &super::ParamCurve,
-    t0: f64,
-    t1: f64,
-) -> Result<Vec<Piece>, String> {
+fn segment_pieces(curve: &super::ParamCurve, t0: f64, t1: f64) -> Result<Vec<Piece>, String> {
     let p = curve.degree;
     if p == 0 || p > MAX_DEGREE {
         return Err(format!("degree {p} is outside 1..={MAX_DEGREE}"));

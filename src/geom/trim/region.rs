@@ -204,7 +204,10 @@ mod tests {
     #[test]
     fn patch_coverage_drops_culls_and_agrees_with_the_whole_region() {
         let c = DVec2::new(0.6, 0.4);
-        let loops = [whole(square(0.0, 1.0, true), false), whole(circle(c, 0.2), true)];
+        let loops = [
+            whole(square(0.0, 1.0, true), false),
+            whole(circle(c, 0.2), true),
+        ];
         let region = TrimRegion::new(&loops, &identity()).unwrap().unwrap();
         // Patches of a 5 × 5 split of [0, 1.25]²: the outer column and row lie outside.
         let n = 5;
@@ -236,6 +239,9 @@ mod tests {
                 }
             }
         }
-        assert!(inside > 0 && outside > 0 && partial > 0, "{inside} {outside} {partial}");
+        assert!(
+            inside > 0 && outside > 0 && partial > 0,
+            "{inside} {outside} {partial}"
+        );
     }
 }

@@ -552,6 +552,7 @@ fn search_avx512(
         ray,
         cfg,
         any_hit,
+        trim,
     }: Query,
     stats: &mut KernelStats,
 ) -> Option<SearchHit<f32>> {
@@ -575,7 +576,7 @@ fn search_avx512(
             let floor = frame.world_length(end_game_diameter(&root, cfg.end_ulps));
             let mut nets = RegisterStack::with_registers(local, registers, floor, slots);
             let hit = search(
-                &mut nets, nodes, local_root, &axis, false, cfg, any_hit, stats,
+                &mut nets, nodes, local_root, &axis, false, cfg, any_hit, trim, stats,
             )?;
             if any_hit {
                 // `occluded` needs no hit box.
@@ -588,7 +589,9 @@ fn search_avx512(
         }
     }
     let mut nets = RegisterStack::new(world, ray, slots);
-    search(&mut nets, nodes, root, ray, false, cfg, any_hit, stats)
+    search(
+        &mut nets, nodes, root, ray, false, cfg, any_hit, trim, stats,
+    )
 }
 
 #[cfg(test)]
@@ -653,6 +656,7 @@ mod tests {
                     ray: &ray,
                     cfg: &cfg,
                     any_hit,
+                    trim: None,
                 };
                 let a = search_net16(&net, &mut scratch16, q, &mut s16);
                 let b = search_register(net, &mut scratch, q, &mut s);
@@ -684,6 +688,7 @@ mod tests {
                 ray,
                 cfg,
                 any_hit: false,
+                trim: None,
             };
             search_net16(&net, &mut scratch, q, &mut stats)
         };

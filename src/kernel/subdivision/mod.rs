@@ -52,6 +52,7 @@ use prepared::Prepared;
 use register::{Query, search_register};
 use search::{SearchHit, search};
 
+use crate::geom::trim::PatchTrim;
 use crate::geom::ulp::ulp_of;
 use crate::geom::{Aabb, Ray};
 use crate::kernel::{KernelStats, PatchHit};
@@ -86,11 +87,12 @@ pub const NET_ROUNDING_ULPS: f64 = 2.0;
 /// Nearest hit with `t` in `[ray.tmin, ray.tmax]`; `ray.tmax` is the current closest hit.
 pub fn intersect(
     patch: &PreparedPatch,
+    trim: Option<&PatchTrim>,
     ray: &Ray,
     cfg: &SubdivisionConfig,
     stats: &mut KernelStats,
 ) -> Option<PatchHit> {
-    run(patch, ray, cfg, false, stats).map(|h| {
+    run(patch, trim, ray, cfg, false, stats).map(|h| {
         let (u, v) = h.cell.centre();
         PatchHit {
             t: h.t,
@@ -113,15 +115,17 @@ pub fn widen_by_net_rounding(hit_box: Aabb, root: &Aabb) -> Aabb {
 /// Any hit in `[ray.tmin, ray.tmax]` (shadow rays): stops at the first final box found.
 pub fn occluded(
     patch: &PreparedPatch,
+    trim: Option<&PatchTrim>,
     ray: &Ray,
     cfg: &SubdivisionConfig,
     stats: &mut KernelStats,
 ) -> bool {
-    run(patch, ray, cfg, true, stats).is_some()
+    run(patch, trim, ray, cfg, true, stats).is_some()
 }
 
 fn run(
     patch: &PreparedPatch,
+    trim: Option<&PatchTrim>,
     ray: &Ray,
     cfg: &SubdivisionConfig,
     any_hit: bool,
@@ -139,6 +143,7 @@ fn run(
         ray: &gray,
         cfg,
         any_hit,
+        trim,
     };
     match &patch.data {
         #[cfg(target_arch = "x86_64")]
@@ -161,6 +166,7 @@ fn run(
                 shape.rational,
                 cfg,
                 any_hit,
+                trim,
                 stats,
             )
         }),

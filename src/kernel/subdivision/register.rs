@@ -21,6 +21,7 @@ use super::jump::JumpOutcome;
 use super::param::{ParamCell, Split};
 use super::search::{NetStack, Node, SearchHit, search};
 use crate::geom::bbox::slab;
+use crate::geom::trim::PatchTrim;
 use crate::kernel::KernelStats;
 
 /// The boxes of a split's two children (lower first), each with the entry `t` of its slab
@@ -229,6 +230,8 @@ pub struct Query<'a> {
     pub ray: &'a GRay<f32>,
     pub cfg: &'a SubdivisionConfig,
     pub any_hit: bool,
+    /// The patch's trim loops, if it has any ([`super::search::search`]).
+    pub trim: Option<&'a PatchTrim>,
 }
 
 /// The reusable buffers of a register-net search: the pushed nets and the search nodes.
@@ -267,7 +270,7 @@ fn search_portable<N: RegisterNet>(
 ) -> Option<SearchHit<f32>> {
     let mut nets = RegisterStack::new(net, q.ray, slots);
     search(
-        &mut nets, nodes, q.root, q.ray, false, q.cfg, q.any_hit, stats,
+        &mut nets, nodes, q.root, q.ray, false, q.cfg, q.any_hit, q.trim, stats,
     )
 }
 
