@@ -225,7 +225,8 @@ impl SceneGeometry {
         let boxes: Vec<Aabb> = patches
             .originals
             .iter()
-            .map(|p| p.tight_box().to_f32_outward())
+            .zip(&patches.trims)
+            .map(|(p, trim)| surviving_box(p, trim.as_deref()).to_f32_outward())
             .chain(
                 triangles
                     .corners
@@ -744,6 +745,37 @@ fn hash_geometry(patches: &[BezierPatch], triangles: &Triangles) -> u64 {
         }
     }
     h.finish()
+}
+
+/// Quarterings of a trimmed patch when bounding the part its loops keep: 4 × 4 pieces.
+const SURVIVING_BOX_LEVELS: u32 = 2;
+
+/// The BVH box of a patch: its tight box, or for a patch its trim loops cut, the union of
+/// the tight boxes of those of its 4 × 4 sub-patches (de Casteljau halvings) that keep any
+/// of the surface ([`PatchTrim::keeps_any_of`]). A plate mostly cut away then no longer
+/// sends every ray through its whole rectangle to the kernel; 16 sub-patches per cut patch
+/// at load is cheap. The kernel still starts from the whole patch.
+fn surviving_box(p: &BezierPatch, trim: Option<&PatchTrim>) -> DAabb {
+    let Some(trim) = trim else {
+        return p.tight_box();
+    };
+    let mut parts = vec![p.clone()];
+    for _ in 0..SURVIVING_BOX_LEVELS {
+        parts = parts
+            .iter()
+            .flat_map(|q| {
+                let (a, b) = q.split_u();
+                let (a0, a1) = a.split_v();
+                let (b0, b1) = b.split_v();
+                [a0, a1, b0, b1]
+            })
+            .collect();
+    }
+    let kept = parts
+        .iter()
+        .filter(|q| trim.keeps_any_of(q.domain()))
+        .fold(DAabb::EMPTY, |acc, q| acc.union(&q.tight_box()));
+    if kept.is_empty() { p.tight_box() } else { kept }
 }
 
 /// All mesh triangles of the scene in object order, rounded to `f32`.

@@ -135,6 +135,27 @@ impl PatchTrim {
     #[inline]
     pub fn keeps(&self, u: f64, v: f64) -> bool {
         let (pu, pv) = self.domain.to_parent(u, v);
+        self.keeps_in_surface(pu, pv)
+    }
+
+    /// Whether any of `part` (a rectangle inside the patch's, in the surface's parameters)
+    /// survives: where no piece overlaps it, it is wholly kept or wholly cut away, as its
+    /// centre is. Used to bound the surviving part of a patch at load.
+    pub fn keeps_any_of(&self, part: ParamRect) -> bool {
+        let (a, b) = (
+            DVec2::new(self.map[0].apply(part.u0), self.map[1].apply(part.v0)),
+            DVec2::new(self.map[0].apply(part.u1), self.map[1].apply(part.v1)),
+        );
+        let (lo, hi) = (a.min(b), a.max(b));
+        let overlaps =
+            |q: &Piece| q.lo.x <= hi.x && q.hi.x >= lo.x && q.lo.y <= hi.y && q.hi.y >= lo.y;
+        self.near.iter().any(overlaps)
+            || self.keeps_in_surface(0.5 * (part.u0 + part.u1), 0.5 * (part.v0 + part.v1))
+    }
+
+    /// Whether the surface exists at (u, v) in the surface's parameters, for (u, v) in
+    /// the patch's rectangle.
+    fn keeps_in_surface(&self, pu: f64, pv: f64) -> bool {
         let p = DVec2::new(self.map[0].apply(pu), self.map[1].apply(pv)).clamp(self.lo, self.hi);
         let mut odd = false;
         for &(a, b) in &self.far {
