@@ -40,6 +40,14 @@ pub enum Command {
     /// Measure the kernels: reports as tables.
     #[command(subcommand)]
     Bench(BenchCommand),
+    /// Join pieces rendered with `render --tile K/N` or `--crop` into the whole image,
+    /// after checking that they come from the same scene and settings and cover the
+    /// image exactly once. The result is byte for byte the image rendered in one piece.
+    Merge(MergeArgs),
+    /// Write a shell completion script to stdout, e.g. `patchtrace completions bash >
+    /// /etc/bash_completion.d/patchtrace` or `patchtrace completions zsh >
+    /// ~/.zfunc/_patchtrace`.
+    Completions(CompletionsArgs),
 }
 
 #[derive(Debug, Subcommand)]
@@ -143,6 +151,8 @@ pub struct TeapotsArgs {
 pub struct InfoArgs {
     /// Scene (.ron) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb).
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
@@ -152,6 +162,8 @@ pub struct InfoArgs {
 pub struct ImportArgs {
     /// Input scene or geometry file.
     pub input: PathBuf,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Output: .ron (scene, geometry inline), .bpt (non-rational patches) or .obj
     /// (free-form Bézier patches).
     #[arg(short, long)]
@@ -162,6 +174,8 @@ pub struct ImportArgs {
 pub struct ConvertArgs {
     /// Input with NURBS surfaces (.obj, .pbrt, .ron) or any other supported geometry.
     pub input: PathBuf,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Output: .obj (free-form Bézier), .bpt (non-rational only) or .ron.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -237,6 +251,32 @@ impl std::str::FromStr for TerminationChoice {
 /// parameter cells go per direction (`kernel::subdivision::param`).
 pub const MAX_DEPTH: u8 = 64;
 
+/// How bare mesh files are read, for every command that takes a scene.
+#[derive(Debug, Args, Clone, Copy, Default)]
+pub struct MeshArgs {
+    /// Read a bare mesh file (OBJ polygons, glTF) as the control cage of a subdivision
+    /// surface and use its limit surface (boundaries sharp, as OpenSubdiv's EDGE_ONLY).
+    /// `trace` then reports as `patch` the quad after the first Catmull–Clark step (cage
+    /// face f with n corners gives quads Σ_{g<f} n_g + 0..n, one per corner) and (u, v)
+    /// in that quad. In a RON scene write `geometry: Subdivision(File("cage.obj"))`.
+    #[arg(long, value_enum, value_name = "SCHEME")]
+    pub subdivide: Option<SubdivideChoice>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SubdivideChoice {
+    /// Catmull–Clark (1978), as Dammertz §2.9 ray traces it.
+    CatmullClark,
+}
+
+impl MeshArgs {
+    pub fn load_options(&self) -> crate::scene::LoadOptions {
+        crate::scene::LoadOptions {
+            subdivide: self.subdivide == Some(SubdivideChoice::CatmullClark),
+        }
+    }
+}
+
 /// Options shared by every command that intersects rays.
 #[derive(Debug, Args, Clone)]
 pub struct KernelArgs {
@@ -305,6 +345,8 @@ pub enum AccelChoice {
 pub struct RenderArgs {
     /// Scene (.ron) or bare geometry.
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Output image: .png (8-bit sRGB) or .exr (linear f32 RGBA).
     #[arg(short, long)]
     pub output: PathBuf,
@@ -322,6 +364,25 @@ pub struct RenderArgs {
     /// the order matters for kernels that cache work between rays.
     #[arg(long, value_enum, default_value_t = crate::render::order::SampleOrder::Tiles)]
     pub order: crate::render::order::SampleOrder,
+    /// Samples per pixel: N (stratified, a deterministic sequence per pixel, so the image
+    /// is the same for any threads, order or tiles; 1 is the pixel centre), or
+    /// `adaptive[:MAX]`: 4 samples everywhere and up to MAX (default 64) where they
+    /// disagree (silhouettes, shadow and reflected edges), with a report of the pixels and
+    /// samples used. Default: the scene's `samples`, else 1.
+    #[arg(long, value_name = "N|adaptive[:MAX]")]
+    pub spp: Option<crate::render::sampler::SampleCount>,
+    /// Reconstruction filter of the samples, importance sampled so pixels stay independent.
+    #[arg(long, value_enum, default_value_t = crate::render::sampler::Filter::Box)]
+    pub filter: crate::render::sampler::Filter,
+    /// Render only pixels X0..X1 × Y0..Y1 (upper bounds exclusive): an EXR gets them as its
+    /// data window inside the whole image's display window, a PNG holds the window alone.
+    /// `patchtrace merge` joins pieces.
+    #[arg(long, value_name = "X0,X1,Y0,Y1", conflicts_with = "tile")]
+    pub crop: Option<crate::render::window::Window>,
+    /// Render the K-th (from 0) of N bands of rows that differ by at most one row, e.g.
+    /// `--tile $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT`; `patchtrace merge` joins them.
+    #[arg(long, value_name = "K/N")]
+    pub tile: Option<crate::render::window::Tile>,
     /// Print statistics as JSON on stdout.
     #[arg(long)]
     pub stats: bool,
@@ -342,9 +403,28 @@ pub enum Aov {
 }
 
 #[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// Pieces rendered with `render --tile K/N` or `--crop`, all EXR or all PNG.
+    #[arg(required = true)]
+    pub pieces: Vec<PathBuf>,
+    /// The whole image: .exr (from EXR pieces, with their AOV layers) or .png.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+#[derive(Debug, Args)]
+pub struct CompletionsArgs {
+    /// The shell to write the completion script for.
+    #[arg(value_enum)]
+    pub shell: clap_complete::Shell,
+}
+
+#[derive(Debug, Args)]
 pub struct TraceArgs {
     /// Scene (.ron) or bare geometry.
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Ray file: `ox oy oz dx dy dz [tmin [tmax]]` per line.
     #[arg(long)]
     pub rays: PathBuf,
@@ -362,6 +442,8 @@ pub struct TraceArgs {
 pub struct BvhArgs {
     /// Scene (.ron) or bare geometry.
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Output BVH file.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -372,6 +454,8 @@ pub struct BvhArgs {
 pub struct TessellateArgs {
     /// Scene (.ron) or bare geometry.
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Output mesh: .obj, .gltf (buffer embedded) or .glb.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -438,6 +522,8 @@ pub struct DiffArgs {
 pub struct CompareArgs {
     /// Scene (.ron) or bare geometry.
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Triangles per patch of each tessellation to compare (even counts 2·u·v).
     #[arg(long, value_delimiter = ',', default_values_t = crate::bench::accuracy::DEFAULT_TRIANGLES)]
     pub triangles: Vec<u32>,
@@ -458,6 +544,8 @@ pub struct CompareArgs {
 pub struct AccuracyArgs {
     /// Scene (.ron) or bare geometry.
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Trace these rays (`ox oy oz dx dy dz [tmin [tmax]]` per line) instead of the
     /// camera's primary rays.
     #[arg(long)]

@@ -25,6 +25,9 @@ pub struct SceneFile {
     pub ambient: Option<f32>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_depth: Option<u32>,
+    /// Samples per pixel (`render --spp` overrides it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub samples: Option<u32>,
     #[serde(default)]
     pub lights: Vec<LightDef>,
     #[serde(default)]
@@ -108,6 +111,9 @@ pub enum GeometryDef {
     File(String),
     /// Inline free-form surfaces.
     Surfaces(Vec<SurfaceDef>),
+    /// A Catmull–Clark surface: `Subdivision(File("cage.obj"))`, a polygon mesh (OBJ or
+    /// glTF) as the control cage, with sharp (`EDGE_ONLY`) boundaries.
+    Subdivision(Box<GeometryDef>),
 }
 
 #[derive(Debug, Serialize, Deserialize)]
@@ -203,6 +209,15 @@ fn build_scene(path: &Path, file: SceneFile) -> Result<Scene, LoadError> {
         height: c.height,
     };
     validate_camera(path, &camera)?;
+    let max_spp = crate::render::sampler::MAX_SPP;
+    if let Some(n) = file.samples
+        && !(1..=max_spp).contains(&n)
+    {
+        return Err(LoadError::invalid(
+            path,
+            format!("samples: expected a count from 1 to {max_spp}, found {n}"),
+        ));
+    }
     let mut materials: Vec<Material> = file
         .materials
         .iter()
@@ -227,6 +242,17 @@ fn build_scene(path: &Path, file: SceneFile) -> Result<Scene, LoadError> {
         };
         let mut geometry = match &o.geometry {
             GeometryDef::File(f) => super::load::load_geometry(&base.join(f))?,
+            GeometryDef::Subdivision(inner) => match inner.as_ref() {
+                GeometryDef::File(f) => super::load::load_subdivision(&base.join(f))?,
+                _ => {
+                    return Err(LoadError::invalid(
+                        path,
+                        format!(
+                            "object {index}: expected Subdivision(File(\"cage.obj\")): a cage is read from a mesh file"
+                        ),
+                    ));
+                }
+            },
             GeometryDef::Surfaces(defs) => Geometry::Surfaces(
                 defs.iter()
                     .enumerate()
@@ -243,13 +269,14 @@ fn build_scene(path: &Path, file: SceneFile) -> Result<Scene, LoadError> {
             .iter()
             .fold(DAffine3::IDENTITY, |acc, t| t.to_affine() * acc);
         if m != DAffine3::IDENTITY {
-            match &mut geometry {
-                Geometry::Surfaces(s) => s.iter_mut().for_each(|s| s.transform(&m)),
-                Geometry::Mesh(mesh) => mesh.transform(&m),
-            }
+            geometry.transform(&m);
         }
         let name = o.name.clone().unwrap_or_else(|| match &o.geometry {
             GeometryDef::File(f) => f.clone(),
+            GeometryDef::Subdivision(inner) => match inner.as_ref() {
+                GeometryDef::File(f) => f.clone(),
+                _ => format!("object{index}"),
+            },
             GeometryDef::Surfaces(_) => format!("object{index}"),
         });
         objects.push(Object {
@@ -283,6 +310,7 @@ fn build_scene(path: &Path, file: SceneFile) -> Result<Scene, LoadError> {
         background: c3(file.background),
         ambient: file.ambient.unwrap_or(DEFAULT_AMBIENT),
         max_depth: file.max_depth.unwrap_or(DEFAULT_MAX_DEPTH),
+        samples: file.samples,
         lights,
         materials,
         objects,
@@ -442,8 +470,14 @@ pub fn scene_to_file(scene: &Scene) -> Result<SceneFile, String> {
     let tc = |v: Vec3| (v.x, v.y, v.z);
     let mut objects = Vec::new();
     for o in &scene.objects {
+        let limit_patches: Vec<Surface>;
         let surfaces = match &o.geometry {
             Geometry::Surfaces(s) => s,
+            // Written as its limit surface's Bézier patches.
+            Geometry::Subdivision(s) => {
+                limit_patches = s.patches.iter().cloned().map(Surface::bezier).collect();
+                &limit_patches
+            }
             Geometry::Mesh(_) => {
                 return Err(format!(
                     "object \"{}\" is a triangle mesh; RON scenes reference meshes by file",
@@ -494,6 +528,7 @@ pub fn scene_to_file(scene: &Scene) -> Result<SceneFile, String> {
         background: tc(scene.background),
         ambient: Some(scene.ambient),
         max_depth: Some(scene.max_depth),
+        samples: scene.samples,
         lights: scene
             .lights
             .iter()

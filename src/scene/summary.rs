@@ -114,6 +114,7 @@ pub fn summarize(scene: &Scene) -> SceneSummary {
                 0,
             ),
             Geometry::Mesh(m) => (0, 0, 0, m.indices.len()),
+            Geometry::Subdivision(_) => (1, 0, 0, 0),
         };
         patches += bez.len();
         nurbs += n;
@@ -136,7 +137,7 @@ pub fn summarize(scene: &Scene) -> SceneSummary {
                     .enumerate()
                     .filter_map(|(k, s)| trim_summary(k, s))
                     .collect(),
-                Geometry::Mesh(_) => Vec::new(),
+                Geometry::Mesh(_) | Geometry::Subdivision(_) => Vec::new(),
             },
         });
     }
