@@ -4,11 +4,11 @@ use std::io::Write;
 use std::process::ExitCode;
 
 use crate::cli::args::InfoArgs;
-use crate::scene::load_scene_with;
+use crate::scene::load::load_scene_noted;
 use crate::scene::summary::summarize;
 
 pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
-    let scene = load_scene_with(&args.scene, args.mesh.load_options())?;
+    let (scene, notes) = load_scene_noted(&args.scene, args.mesh.load_options())?;
     let s = summarize(&scene);
     let mut out = std::io::stdout().lock();
     if args.json {
@@ -51,6 +51,19 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
                 t.patches_culled
             )?;
         }
+        if let Some(sd) = &o.subdivision {
+            writeln!(
+                out,
+                "    Catmull–Clark cage: {} vertices, {} faces -> {} quads; {} regular patches, {} extraordinary ends, {} T-junctions, {} levels",
+                sd.cage_vertices,
+                sd.cage_faces,
+                sd.quads,
+                sd.regular_patches,
+                sd.extraordinary_ends,
+                sd.t_junctions,
+                sd.levels
+            )?;
+        }
     }
     let degrees: Vec<String> = s.degrees.iter().map(|(d, n)| format!("{d}: {n}")).collect();
     writeln!(
@@ -74,5 +87,8 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
         }
     )?;
     writeln!(out, "max depth: {}", s.max_depth)?;
+    for note in notes {
+        writeln!(out, "{note}")?;
+    }
     Ok(ExitCode::SUCCESS)
 }

@@ -15,6 +15,7 @@ pub mod obj;
 pub mod pbrt;
 pub mod rays;
 pub mod ron_format;
+pub mod step;
 pub mod summary;
 pub mod text;
 pub mod write;
