@@ -488,8 +488,9 @@ fn surf_range_restricts_the_surface_exactly() {
     // spans restricted to [0.5, 1.5] keeps parts of both.
     let src = "v 0 0 0\nv 4 0 0\nv 0 2 0\nv 4 2 1\ncstype bspline\ndeg 1 1\nsurf 1 3 0 2.5 1 2 3 4\nparm u 0 0 4 4\nparm v 0 0 2 2\nend\n\
         v 0 0 5\nv 1 0 5\nv 2 0 5\nv 0 1 5\nv 1 1 5\nv 2 1 6\ncstype bezier\ndeg 1 1\nsurf 0.5 1.5 0 1 5 6 7 8 9 10\nparm u 0 1 2\nparm v 0 1\nend\n";
-    let surfaces = patchtrace::scene::obj::parse_obj_freeform(std::path::Path::new("range.obj"), src)
-        .expect("parses");
+    let surfaces =
+        patchtrace::scene::obj::parse_obj_freeform(std::path::Path::new("range.obj"), src)
+            .expect("parses");
     let patchtrace::scene::SurfaceGeometry::Nurbs(n) = &surfaces[0].geometry else {
         panic!("a B-spline surface");
     };
@@ -498,7 +499,10 @@ fn surf_range_restricts_the_surface_exactly() {
     // The plane's height is u v / 8 (bilinear through the corners): check it on the range.
     for (u, v) in [(1.0, 0.0), (3.0, 2.0), (2.2, 0.7)] {
         let p = n.eval(u, v);
-        assert!((p - glam::DVec3::new(u, v, u * v / 8.0)).length() < 1e-14, "{p}");
+        assert!(
+            (p - glam::DVec3::new(u, v, u * v / 8.0)).length() < 1e-14,
+            "{p}"
+        );
     }
     let beziers: Vec<_> = surfaces[1..]
         .iter()
