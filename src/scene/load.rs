@@ -100,16 +100,31 @@ pub fn check_f32_range(path: &Path, scene: &Scene) -> Result<(), LoadError> {
             ));
         }
         let largest = b.min.abs().max(b.max.abs()).max_element();
-        if !((largest as f32).is_finite()) {
+        // Box arithmetic (slab tests, extents, the default camera's distance) works on
+        // differences of coordinates, so the extent must fit as well: a patch at ±3e38
+        // has finite corners but an infinite f32 width.
+        if !((largest as f32).is_finite()) || !((extent as f32).is_finite()) {
             return Err(LoadError::invalid(
                 path,
                 format!(
-                    "object \"{}\": coordinates reach {largest:e} after transforms, beyond the f32 range (±{:e}) the renderer works in",
+                    "object \"{}\": coordinates reach {largest:e} and the box spans {extent:e} after transforms, beyond the f32 range (±{:e}) the renderer works in; scale the scene down",
                     o.name,
                     f32::MAX
                 ),
             ));
         }
+    }
+    let c = &scene.camera;
+    if !(c.eye.as_vec3().is_finite() && c.look_at.as_vec3().is_finite()) {
+        return Err(LoadError::invalid(
+            path,
+            format!(
+                "camera: eye {} or look_at {} is beyond the f32 range (±{:e}) the renderer works in",
+                c.eye,
+                c.look_at,
+                f32::MAX
+            ),
+        ));
     }
     Ok(())
 }

@@ -61,13 +61,36 @@ pub fn parse_rays(path: &Path, src: &str) -> Result<Vec<RayQuery>, ParseError> {
                 parse_finite(path, tok, NAMES[k])?
             };
         }
+        // The kernels take the ray in f32: a component beyond its range would become
+        // infinite there (and an infinite origin reaches every box plane at t = inf), so
+        // it is refused here, where the ray and the number can be named. tmax may be
+        // infinite: a bound beyond f32 rounds to the same unbounded ray.
+        for (k, tok) in tokens.iter().enumerate().take(7) {
+            if !(v[k] as f32).is_finite() {
+                return Err(ParseError::new(
+                    path,
+                    index + 1,
+                    tok.column,
+                    format!(
+                        "expected {} within the f32 range (±{:e}) the kernels work in, found `{}` (ray {})",
+                        NAMES[k],
+                        f32::MAX,
+                        tok.text,
+                        rays.len()
+                    ),
+                ));
+            }
+        }
         let dir = DVec3::new(v[3], v[4], v[5]);
-        if dir == DVec3::ZERO {
+        if dir.as_vec3() == glam::Vec3::ZERO {
             return Err(ParseError::new(
                 path,
                 index + 1,
                 tokens[3].column,
-                "expected a non-zero direction",
+                format!(
+                    "expected a non-zero direction (ray {}: it is zero, or too small to survive rounding to f32)",
+                    rays.len()
+                ),
             ));
         }
         if v[6] > v[7] {
@@ -111,5 +134,25 @@ mod tests {
         assert!(e.message.contains("6 to 8 numbers"), "{e}");
         let e = parse_rays(Path::new("r.txt"), "0 0 0 0 0 0\n").unwrap_err();
         assert!(e.message.contains("non-zero direction"), "{e}");
+    }
+
+    #[test]
+    fn components_beyond_f32_and_vanishing_directions_are_refused_where_they_stand() {
+        // Issue 21: origin 4e38 rounded to inf in f32 and overflowed the BVH stack.
+        let e = parse_rays(Path::new("r"), "0 0 0 0 0 1\n4e38 -8e38 4e38 -1 2 -1\n").unwrap_err();
+        assert_eq!((e.line, e.column), (2, 1), "{e}");
+        assert!(
+            e.message.starts_with("expected ox within the f32 range"),
+            "{e}"
+        );
+        assert!(e.message.contains("ray 1"), "{e}");
+        let e = parse_rays(Path::new("r"), "0 0 0 0 0 1 3.5e38\n").unwrap_err();
+        assert_eq!(e.column, 13, "{e}");
+        // 1e-50 is not zero in f64 but is in f32.
+        let e = parse_rays(Path::new("r"), "0 0 0 1e-50 0 0\n").unwrap_err();
+        assert!(e.message.contains("non-zero direction"), "{e}");
+        // The largest finite f32 values and an infinite tmax stay accepted.
+        let r = parse_rays(Path::new("r"), "3.4e38 0 0 -1 0 0 0 1e39\n").unwrap();
+        assert_eq!(r[0].origin.x, 3.4e38);
     }
 }
