@@ -63,3 +63,42 @@ impl LoadError {
 pub fn read_text(path: &Path) -> Result<String, LoadError> {
     std::fs::read_to_string(path).map_err(|e| LoadError::io(path, e))
 }
+
+/// The 1-based line and column (in characters) of byte offset `byte` of `src`, for readers
+/// that find a problem by offset (a JSON value, a RON key, a base64 digit); offsets past
+/// the end give the end, and an offset inside a character counts as that character.
+pub fn line_column(src: &str, byte: usize) -> (usize, usize) {
+    let mut end = byte.min(src.len());
+    while !src.is_char_boundary(end) {
+        end -= 1;
+    }
+    let before = &src[..end];
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let line = before.matches('\n').count() + 1;
+    (line, before[line_start..].chars().count() + 1)
+}
+
+impl ParseError {
+    /// An error at byte offset `byte` of the text `src` of `path`.
+    pub fn at_byte(path: &Path, src: &str, byte: usize, message: impl Into<String>) -> Self {
+        let (line, column) = line_column(src, byte);
+        ParseError::new(path, line, column, message)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn byte_offsets_become_lines_and_character_columns() {
+        let src = "ab\nçd\n";
+        assert_eq!(line_column(src, 0), (1, 1));
+        assert_eq!(line_column(src, 2), (1, 3));
+        assert_eq!(line_column(src, 3), (2, 1));
+        // 'ç' is two bytes: 'd' at byte 5 is the second character.
+        assert_eq!(line_column(src, 5), (2, 2));
+        assert_eq!(line_column(src, 4), (2, 1));
+        assert_eq!(line_column(src, 99), (3, 1));
+    }
+}

@@ -14,6 +14,7 @@ pub mod obj;
 pub mod pbrt;
 pub mod rays;
 pub mod ron_format;
+pub mod ron_locate;
 pub mod summary;
 pub mod text;
 pub mod write;
