@@ -20,6 +20,34 @@ pub struct Camera {
     pub height: u32,
 }
 
+/// Longest image edge, in pixels (2^15).
+pub const MAX_IMAGE_EDGE: u32 = 1 << 15;
+
+/// Largest image, in pixels: 2^26 (8192 × 8192). The film keeps an `f32` RGBA value per
+/// pixel, 16 bytes, so this is 1 GiB; a 100000 × 100000 request asked for 160 GB at once
+/// (issue 21). Larger images are rendered in pieces.
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 26;
+
+impl Camera {
+    /// Refuses an image with a zero edge or beyond [`MAX_IMAGE_EDGE`] or
+    /// [`MAX_IMAGE_PIXELS`], naming the limit.
+    pub fn check_size(&self) -> Result<(), String> {
+        let (w, h) = (self.width, self.height);
+        if w == 0 || h == 0 || w > MAX_IMAGE_EDGE || h > MAX_IMAGE_EDGE {
+            return Err(format!(
+                "width and height must be 1 to {MAX_IMAGE_EDGE}, found {w}x{h}"
+            ));
+        }
+        let pixels = u64::from(w) * u64::from(h);
+        if pixels > MAX_IMAGE_PIXELS {
+            return Err(format!(
+                "a {w}x{h} image has {pixels} pixels, above the budget of {MAX_IMAGE_PIXELS} (8192x8192: 1 GiB of f32 RGBA film)"
+            ));
+        }
+        Ok(())
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub enum Light {
     Point {
