@@ -10,11 +10,16 @@
 //! - `insert`: knot insertion and clamping.
 //! - `decompose`: Bézier decomposition.
 //! - `shapes`: exact torus and sphere built from the 9-point circle.
+//! - `analytic`: analytic curves and surfaces (arcs, conics, planes, quadrics, tori,
+//!   revolutions, extrusions, ruled surfaces) as exact rational NURBS for the CAD readers.
+//! - `inversion`: the closest point of a surface to a point (The NURBS Book §6.1).
 
+pub mod analytic;
 pub mod basis;
 pub mod curve;
 pub mod decompose;
 pub mod insert;
+pub mod inversion;
 pub mod knots;
 pub mod shapes;
 pub mod surface;
