@@ -26,11 +26,36 @@ impl ParseError {
     }
 }
 
+/// A content error at a byte offset of a binary file (a GLB header or chunk): what a
+/// line and column are to a text file.
+#[derive(Debug, Error, Clone, PartialEq)]
+#[error("byte {offset}: {message}")]
+pub struct BinaryError {
+    pub offset: usize,
+    pub message: String,
+}
+
+impl BinaryError {
+    pub fn new(offset: usize, message: impl Into<String>) -> Self {
+        BinaryError {
+            offset,
+            message: message.into(),
+        }
+    }
+}
+
 /// Anything that can go wrong loading or saving a scene.
 #[derive(Debug, Error)]
 pub enum LoadError {
     #[error(transparent)]
     Parse(#[from] ParseError),
+    /// An error at a byte offset of a binary file.
+    #[error("{}: {source}", path.display())]
+    Binary {
+        path: PathBuf,
+        #[source]
+        source: BinaryError,
+    },
     #[error("{}: {source}", path.display())]
     Io {
         path: PathBuf,
@@ -46,6 +71,13 @@ pub enum LoadError {
 impl LoadError {
     pub fn io(path: &Path, source: std::io::Error) -> Self {
         LoadError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+
+    pub fn binary(path: &Path, source: BinaryError) -> Self {
+        LoadError::Binary {
             path: path.to_path_buf(),
             source,
         }

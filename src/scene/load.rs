@@ -4,7 +4,7 @@ use std::path::Path;
 
 use super::error::LoadError;
 use super::model::{Geometry, Object, Scene, Surface};
-use super::{bpt, mesh, obj, pbrt, ron_format};
+use super::{bpt, gltf_mesh, mesh, obj, pbrt, ron_format};
 
 /// The kinds of input file we read, by extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -58,7 +58,7 @@ pub fn load_geometry(path: &Path) -> Result<Geometry, LoadError> {
             let src = super::error::read_text(path)?;
             Ok(Geometry::Surfaces(pbrt::parse_pbrt(path, &src)?))
         }
-        InputKind::Gltf => Ok(Geometry::Mesh(mesh::read_gltf(path)?)),
+        InputKind::Gltf => Ok(Geometry::Mesh(gltf_mesh::read_gltf(path)?)),
         InputKind::Ron => Err(LoadError::invalid(
             path,
             "a scene cannot be used as geometry; reference its geometry files instead",

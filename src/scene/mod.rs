@@ -1,12 +1,13 @@
 //! The scene model and one reader/writer per format: our RON scene, `.bpt` Bézier patch
 //! files, Wavefront OBJ free-form surfaces, pbrt-v3 `Shape "nurbs"`, and triangle meshes
-//! (OBJ via tobj, glTF via gltf). Every reader reports errors as `file:line:col: what was
+//! (polygonal OBJ, glTF and GLB). Every reader reports errors as `file:line:col: what was
 //! expected`; every writer writes to a temporary name and renames.
 
 pub mod bpt;
 pub mod convert;
 pub mod error;
 pub mod generate;
+pub mod gltf_mesh;
 pub mod load;
 pub mod mesh;
 pub mod model;
