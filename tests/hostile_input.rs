@@ -231,3 +231,57 @@ fn bvh_traversal_from_an_infinite_origin_ends_without_visiting_anything() {
         assert_eq!(calls, 0);
     }
 }
+
+#[test]
+fn trace_streams_chunks_in_order_and_a_bad_line_leaves_no_output() {
+    // Rays are read, traced and written a chunk (2^16 rays) at a time: more rays than one
+    // chunk must come out in input order, and a bad line after the first chunk must leave
+    // no output file behind.
+    let d = Dir::new();
+    let n = (1 << 16) + 10;
+    let mut text = String::with_capacity(n * 16);
+    for i in 0..n {
+        // Rays from below the teapot straight up, alternately missing far to the side.
+        let x = if i % 2 == 0 { 0.0 } else { 100.0 };
+        text.push_str(&format!("{x} 0 -5 0 0 1\n"));
+    }
+    let rays = d.file("many.rays", &text);
+    let out = d.path("out.csv");
+    let o = run(&[
+        "trace",
+        s(&testdata("teapot.ron")),
+        "--rays",
+        s(&rays),
+        "-o",
+        s(&out),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let csv = std::fs::read_to_string(&out).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), n);
+    for (i, r) in rows.iter().enumerate() {
+        let mut f = r.split(',');
+        assert_eq!(f.next(), Some(i.to_string().as_str()));
+        assert_eq!(
+            f.next(),
+            Some(if i % 2 == 0 { "1" } else { "0" }),
+            "row {r}"
+        );
+    }
+    std::fs::remove_file(&out).unwrap();
+    let bad = d.file("bad.rays", &format!("{text}0 0 0 0 0 x\n"));
+    let o = run(&[
+        "trace",
+        s(&testdata("teapot.ron")),
+        "--rays",
+        s(&bad),
+        "-o",
+        s(&out),
+    ]);
+    let err = refused(&o);
+    assert!(
+        err.contains(&format!("bad.rays:{}:11: expected dz", n + 1)),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
