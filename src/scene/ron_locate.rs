@@ -7,6 +7,7 @@
 use std::path::Path;
 
 use super::error::ParseError;
+use super::text::quoted_end;
 
 /// A key or a call in the text.
 #[derive(Clone, Debug, PartialEq)]
@@ -102,7 +103,7 @@ fn scan(src: &str) -> Vec<Mark> {
         }
         let word = pending.take();
         if c == b'"' {
-            let end = skip_string(b, i);
+            let end = quoted_end(b, i);
             pending = Some((
                 String::from_utf8_lossy(&b[i + 1..end.saturating_sub(1).max(i + 1)]).into_owned(),
                 i,
@@ -131,19 +132,6 @@ fn scan(src: &str) -> Vec<Mark> {
         i += 1;
     }
     marks
-}
-
-/// The offset after the string starting at `start` (a `"`), escapes skipped.
-fn skip_string(b: &[u8], start: usize) -> usize {
-    let mut i = start + 1;
-    while i < b.len() {
-        match b[i] {
-            b'\\' => i += 2,
-            b'"' => return i + 1,
-            _ => i += 1,
-        }
-    }
-    b.len()
 }
 
 /// The offset after the (nested) block comment starting at `start`.

@@ -3,6 +3,8 @@
 //! they are about. Strings are skipped with their escapes (RFC 8259 §7), so brackets inside
 //! names do not count.
 
+use super::super::text::quoted_end;
+
 /// Offset of element `index` of the array under the top-level key `key`, or of the key
 /// itself when the array is shorter, or `None` without the key.
 pub fn element(json: &str, key: &str, index: usize) -> Option<usize> {
@@ -30,7 +32,7 @@ pub fn element(json: &str, key: &str, index: usize) -> Option<usize> {
         }
         match c {
             b'"' => {
-                let end = string_end(b, i);
+                let end = quoted_end(b, i);
                 if array.is_none()
                     && depth == 1
                     && &b[i + 1..end.saturating_sub(1).max(i + 1)] == key.as_bytes()
@@ -73,19 +75,6 @@ pub fn element(json: &str, key: &str, index: usize) -> Option<usize> {
         i += 1;
     }
     array.map(|(_, _, at)| at)
-}
-
-/// The offset after the string starting at `start` (a `"`).
-fn string_end(b: &[u8], start: usize) -> usize {
-    let mut i = start + 1;
-    while i < b.len() {
-        match b[i] {
-            b'\\' => i += 2,
-            b'"' => return i + 1,
-            _ => i += 1,
-        }
-    }
-    b.len()
 }
 
 #[cfg(test)]
