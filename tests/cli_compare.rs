@@ -5,7 +5,7 @@ mod common;
 use common::{run, stderr, stdout, testdata};
 
 #[test]
-fn obj_and_gltf_of_the_same_mesh_render_the_same_bytes() {
+fn obj_and_gltf_of_the_same_mesh_render_the_same_pixels() {
     let dir = tempfile::tempdir().unwrap();
     let mut images = Vec::new();
     for name in ["quad_mesh.obj", "quad_mesh.gltf"] {
@@ -22,9 +22,11 @@ fn obj_and_gltf_of_the_same_mesh_render_the_same_bytes() {
             "48",
         ]);
         assert!(o.status.success(), "{name}: {}", stderr(&o));
-        images.push(std::fs::read(&out).unwrap());
+        // The pixels, not the file: the file records the scene's fingerprint, and the two
+        // readers' meshes differ in what the fingerprint sees (e.g. stored normals).
+        images.push(image::open(&out).unwrap().to_rgba8().into_raw());
     }
-    assert_eq!(images[0], images[1]);
+    assert!(images[0] == images[1]);
 }
 
 #[test]

@@ -140,7 +140,7 @@ fn flags_beyond_their_limits_exit_2_naming_the_limit() {
         (&["--width", "100000"], "1..=32768"),
         (
             &["--width", "30000", "--height", "30000"],
-            "budget of 67108864",
+            "budget of 67108864 (8192x8192: 1 GiB of f32 RGBA); render it in pieces",
         ),
     ];
     for (flags, limit) in cases {

@@ -40,6 +40,14 @@ pub enum Command {
     /// Measure the kernels: reports as tables.
     #[command(subcommand)]
     Bench(BenchCommand),
+    /// Join pieces rendered with `render --tile K/N` or `--crop` into the whole image,
+    /// after checking that they come from the same scene and settings and cover the
+    /// image exactly once. The result is byte for byte the image rendered in one piece.
+    Merge(MergeArgs),
+    /// Write a shell completion script to stdout, e.g. `patchtrace completions bash >
+    /// /etc/bash_completion.d/patchtrace` or `patchtrace completions zsh >
+    /// ~/.zfunc/_patchtrace`.
+    Completions(CompletionsArgs),
 }
 
 #[derive(Debug, Subcommand)]
@@ -320,6 +328,25 @@ pub struct RenderArgs {
     /// the order matters for kernels that cache work between rays.
     #[arg(long, value_enum, default_value_t = crate::render::order::SampleOrder::Tiles)]
     pub order: crate::render::order::SampleOrder,
+    /// Samples per pixel: N (stratified, a deterministic sequence per pixel, so the image
+    /// is the same for any threads, order or tiles; 1 is the pixel centre), or
+    /// `adaptive[:MAX]`: 4 samples everywhere and up to MAX (default 64) where they
+    /// disagree (silhouettes, shadow and reflected edges), with a report of the pixels and
+    /// samples used. Default: the scene's `samples`, else 1.
+    #[arg(long, value_name = "N|adaptive[:MAX]")]
+    pub spp: Option<crate::render::sampler::SampleCount>,
+    /// Reconstruction filter of the samples, importance sampled so pixels stay independent.
+    #[arg(long, value_enum, default_value_t = crate::render::sampler::Filter::Box)]
+    pub filter: crate::render::sampler::Filter,
+    /// Render only pixels X0..X1 × Y0..Y1 (upper bounds exclusive): an EXR gets them as its
+    /// data window inside the whole image's display window, a PNG holds the window alone.
+    /// `patchtrace merge` joins pieces.
+    #[arg(long, value_name = "X0,X1,Y0,Y1", conflicts_with = "tile")]
+    pub crop: Option<crate::render::window::Window>,
+    /// Render the K-th (from 0) of N bands of rows that differ by at most one row, e.g.
+    /// `--tile $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT`; `patchtrace merge` joins them.
+    #[arg(long, value_name = "K/N")]
+    pub tile: Option<crate::render::window::Tile>,
     /// Print statistics as JSON on stdout.
     #[arg(long)]
     pub stats: bool,
@@ -337,6 +364,23 @@ pub struct RenderArgs {
 pub enum Aov {
     /// de Casteljau splits of all rays started from each pixel.
     Effort,
+}
+
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// Pieces rendered with `render --tile K/N` or `--crop`, all EXR or all PNG.
+    #[arg(required = true)]
+    pub pieces: Vec<PathBuf>,
+    /// The whole image: .exr (from EXR pieces, with their AOV layers) or .png.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+#[derive(Debug, Args)]
+pub struct CompletionsArgs {
+    /// The shell to write the completion script for.
+    #[arg(value_enum)]
+    pub shell: clap_complete::Shell,
 }
 
 #[derive(Debug, Args)]
@@ -490,10 +534,10 @@ pub struct AccuracyArgs {
 /// Overrides of the scene camera's image size.
 #[derive(Debug, Args, Clone, Copy)]
 pub struct ImageSizeArgs {
-    /// Override the camera's image width (1 to 32768; at most 2^26 pixels in all).
+    /// Override the camera's image width (1 to 32768; a render holds at most 2^26 pixels).
     #[arg(long, value_parser = image_edge())]
     pub width: Option<u32>,
-    /// Override the camera's image height (1 to 32768; at most 2^26 pixels in all).
+    /// Override the camera's image height (1 to 32768; a render holds at most 2^26 pixels).
     #[arg(long, value_parser = image_edge())]
     pub height: Option<u32>,
 }
@@ -503,8 +547,8 @@ fn image_edge() -> clap::builder::RangedI64ValueParser<u32> {
 }
 
 impl ImageSizeArgs {
-    /// Applies the overrides to `camera`, refusing an image beyond the pixel budget
-    /// ([`Camera::check_size`](crate::scene::Camera::check_size)).
+    /// Applies the overrides to `camera`, refusing an edge beyond
+    /// [`MAX_IMAGE_EDGE`](crate::scene::MAX_IMAGE_EDGE).
     pub fn apply(&self, camera: &mut crate::scene::Camera) -> anyhow::Result<()> {
         camera.width = self.width.unwrap_or(camera.width);
         camera.height = self.height.unwrap_or(camera.height);

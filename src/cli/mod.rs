@@ -9,11 +9,13 @@ mod bench_accuracy;
 mod bench_lg90;
 mod bvh;
 mod compare;
+mod completions;
 mod convert;
 mod diff;
 mod import;
 mod info;
 pub mod man;
+mod merge;
 mod render;
 mod scene_gen;
 mod setup;
@@ -77,6 +79,8 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Scene(args::SceneCommand::Teapots(a)) => scene_gen::teapots(a),
         Command::Bench(args::BenchCommand::Stability(a)) => bench::stability(a),
         Command::Bench(args::BenchCommand::Lg90(a)) => bench_lg90::run(a),
+        Command::Merge(a) => merge::run(a),
+        Command::Completions(a) => completions::run(a),
     }
 }
 

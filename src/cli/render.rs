@@ -10,10 +10,74 @@ use crate::cli::args::{Aov, RenderArgs};
 use crate::cli::setup::{precision, prepare, thread_pool};
 use crate::render::film::{ImageFormat, write_effort};
 use crate::render::integrator::{Integrator, TraceSettings};
+use crate::render::piece::{PieceInfo, fingerprint, write_exr, write_png};
 use crate::render::plan::EffectPlan;
-use crate::render::renderer::{progress_bar, render_image_in_order};
+use crate::render::renderer::{RenderJob, progress_bar, render};
+use crate::render::sampler::SampleCount;
 use crate::render::stats::{PhaseTimes, RayReport};
-use crate::scene::LoadError;
+use crate::render::window::Window;
+use crate::scene::{LoadError, Scene};
+
+/// How many samples a render took.
+#[derive(Serialize)]
+struct SamplingReport {
+    /// `--spp` as given (or the scene's `samples`).
+    spp: String,
+    total: u64,
+    per_pixel: f64,
+    /// Pixels that got more than the first samples (adaptive sampling).
+    refined_pixels: usize,
+}
+
+impl SamplingReport {
+    fn of(per_pixel: &[u32], spp: SampleCount) -> SamplingReport {
+        let total: u64 = per_pixel.iter().map(|&n| n as u64).sum();
+        let first = match spp {
+            SampleCount::Adaptive { max } => crate::render::sampler::ADAPTIVE_FIRST.min(max),
+            SampleCount::Fixed(n) => n,
+        };
+        SamplingReport {
+            spp: spp.to_string(),
+            total,
+            per_pixel: total as f64 / per_pixel.len().max(1) as f64,
+            refined_pixels: per_pixel.iter().filter(|&&n| n > first).count(),
+        }
+    }
+}
+
+/// What made the image, as pieces record it so `merge` can refuse pieces of different
+/// renders: the program version, fingerprints of the scene as loaded (after `--width` and
+/// `--height`; everything but object names, which change no pixel) and of the kernel
+/// flags, and every setting that changes pixels. `--bvh`
+/// is left out: a BVH file is the BVH the scene builds, wherever it is stored.
+fn provenance(scene: &Scene, args: &RenderArgs, samples: SampleCount) -> String {
+    let kernel = crate::cli::args::KernelArgs {
+        bvh: None,
+        ..args.kernel.clone()
+    };
+    let aov: Vec<String> = args.aov.iter().map(|a| format!("{a:?}")).collect();
+    format!(
+        "patchtrace {}; scene {:016x}; size {}x{}; spp {samples}; filter {:?}; ulps {}; kernel {:016x}; aov [{}]",
+        env!("CARGO_PKG_VERSION"),
+        fingerprint(&(
+            &scene.camera,
+            (scene.background, scene.ambient, scene.max_depth),
+            &scene.lights,
+            &scene.materials,
+            scene
+                .objects
+                .iter()
+                .map(|o| (o.material, &o.geometry))
+                .collect::<Vec<_>>(),
+        )),
+        scene.camera.width,
+        scene.camera.height,
+        args.filter,
+        args.ulps,
+        fingerprint(&kernel),
+        aov.join(",")
+    )
+}
 
 #[derive(Serialize)]
 struct RenderStats {
@@ -22,6 +86,7 @@ struct RenderStats {
     height: u32,
     threads: usize,
     patches: usize,
+    samples: SamplingReport,
     rays: RayReport,
     seconds: PhaseTimes,
 }
@@ -59,13 +124,55 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
             plan,
         },
     };
+    let samples = args
+        .spp
+        .or(scene.samples.map(SampleCount::Fixed))
+        .unwrap_or_default();
+    let (width, height) = (scene.camera.width, scene.camera.height);
+    let window = match (args.crop, args.tile) {
+        (Some(crop), _) => {
+            crop.check(width, height)
+                .map_err(|e| anyhow::anyhow!("--crop {crop}: {e}"))?;
+            crop
+        }
+        (None, Some(tile)) => Window::tile(tile, width, height).map_err(anyhow::Error::msg)?,
+        (None, None) => Window::full(width, height),
+    };
+    crate::scene::check_film_pixels(window.width(), window.height())
+        .map_err(crate::cli::BadArgument)?;
+    let job = RenderJob {
+        order: args.order,
+        samples,
+        filter: args.filter,
+        window,
+        hits: false,
+    };
+    let info = PieceInfo {
+        width,
+        height,
+        window,
+        provenance: provenance(integrator.scene, &args, samples),
+    };
     let bar = progress_bar(args.quiet, "rendering");
     let start = Instant::now();
-    let rendered = pool.install(|| render_image_in_order(&integrator, args.order, &bar));
+    let rendered = pool.install(|| render(&integrator, &job, &bar));
     let (film, tally) = (&rendered.film, &rendered.tally);
     let render_seconds = start.elapsed().as_secs_f64();
+    let sampling = SamplingReport::of(&rendered.samples, samples);
+    if let (SampleCount::Adaptive { max }, false) = (samples, args.quiet) {
+        eprintln!(
+            "adaptive sampling: {} of {} pixels refined to {max} samples, {} samples in all ({:.2} per pixel)",
+            sampling.refined_pixels,
+            rendered.samples.len(),
+            sampling.total,
+            sampling.per_pixel
+        );
+    }
     let start = Instant::now();
-    film.write(&args.output)?;
+    match ImageFormat::of(&args.output) {
+        Some(ImageFormat::Exr) => write_exr(&args.output, &info, film.rgba_channels())?,
+        _ => write_png(&args.output, &info, &film.to_srgb8())?,
+    }
     if args.aov.contains(&Aov::Effort) {
         let [exr, png] = write_effort(&args.output, film.width, film.height, &rendered.effort)?;
         if !args.quiet {
@@ -85,6 +192,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
             height: film.height,
             threads: pool.current_num_threads(),
             patches: prepared.geometry.patch_count(),
+            samples: sampling,
             rays: tally.report(),
             seconds: PhaseTimes {
                 load: prepared.load_seconds,

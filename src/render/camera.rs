@@ -47,7 +47,12 @@ impl CameraRays {
 
     /// The ray through the centre of pixel (x, y), rounded once to `f32`.
     pub fn ray(&self, x: u32, y: u32) -> Ray {
-        let (o, d) = self.ray_f64(x, y, 0.5, 0.5);
+        self.ray_at(x, y, 0.5, 0.5)
+    }
+
+    /// The ray through offset (sx, sy) of pixel (x, y), rounded once to `f32`.
+    pub fn ray_at(&self, x: u32, y: u32, sx: f64, sy: f64) -> Ray {
+        let (o, d) = self.ray_f64(x, y, sx, sy);
         Ray::new(o.as_vec3(), d.as_vec3())
     }
 

@@ -59,6 +59,45 @@ impl Film {
         out
     }
 
+    /// The pixels as the EXR channels `R`, `G`, `B`, `A` (linear f32).
+    pub fn rgba_channels(&self) -> Vec<exr::prelude::AnyChannel<exr::prelude::FlatSamples>> {
+        use exr::prelude::{AnyChannel, FlatSamples};
+        let channel = |name: &str, c: fn(&Vec4) -> f32| {
+            AnyChannel::new(name, FlatSamples::F32(self.pixels.iter().map(c).collect()))
+        };
+        vec![
+            channel("R", |p| p.x),
+            channel("G", |p| p.y),
+            channel("B", |p| p.z),
+            channel("A", |p| p.w),
+        ]
+    }
+
+    /// A film from the `R`, `G`, `B`, `A` f32 channels among `channels`; `None` when one
+    /// is missing or has another type or length.
+    pub fn from_rgba_channels(
+        width: u32,
+        height: u32,
+        channels: &[exr::prelude::AnyChannel<exr::prelude::FlatSamples>],
+    ) -> Option<Film> {
+        let n = width as usize * height as usize;
+        let get = |name: &str| {
+            channels
+                .iter()
+                .find(|c| c.name.to_string() == name)
+                .and_then(|c| match &c.sample_data {
+                    exr::prelude::FlatSamples::F32(v) if v.len() == n => Some(v),
+                    _ => None,
+                })
+        };
+        let [r, g, b, a] = [get("R")?, get("G")?, get("B")?, get("A")?];
+        Some(Film {
+            width,
+            height,
+            pixels: (0..n).map(|i| Vec4::new(r[i], g[i], b[i], a[i])).collect(),
+        })
+    }
+
     /// Writes by extension, atomically.
     pub fn write(&self, path: &Path) -> Result<(), LoadError> {
         match ImageFormat::of(path) {

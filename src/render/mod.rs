@@ -1,10 +1,14 @@
-//! Rendering: camera rays, the Whitted integrator with its effect plan, the film and image
-//! output, sampling orders (LG90 §5), and statistics.
+//! Rendering: camera rays, pixel samples and filters, the Whitted integrator with its
+//! effect plan, the film and image output, sampling orders (LG90 §5), windows and tiles,
+//! and statistics.
 
 pub mod camera;
 pub mod film;
 pub mod integrator;
 pub mod order;
+pub mod piece;
 pub mod plan;
 pub mod renderer;
+pub mod sampler;
 pub mod stats;
+pub mod window;

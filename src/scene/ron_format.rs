@@ -26,6 +26,9 @@ pub struct SceneFile {
     pub ambient: Option<f32>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_depth: Option<u32>,
+    /// Samples per pixel (`render --spp` overrides it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub samples: Option<u32>,
     #[serde(default)]
     pub lights: Vec<LightDef>,
     #[serde(default)]
@@ -221,6 +224,17 @@ fn build_scene(path: &Path, at: &RonLocator, file: SceneFile) -> Result<Scene, L
         height: c.height,
     };
     validate_camera(&camera).map_err(|m| at.at_key("camera", m))?;
+    let max_spp = crate::render::sampler::MAX_SPP;
+    if let Some(n) = file.samples
+        && !(1..=max_spp).contains(&n)
+    {
+        return Err(at
+            .at_key(
+                "samples",
+                format!("samples: expected a count from 1 to {max_spp}, found {n}"),
+            )
+            .into());
+    }
     let mut materials: Vec<Material> = file
         .materials
         .iter()
@@ -302,6 +316,7 @@ fn build_scene(path: &Path, at: &RonLocator, file: SceneFile) -> Result<Scene, L
         background: c3(file.background),
         ambient: file.ambient.unwrap_or(DEFAULT_AMBIENT),
         max_depth: file.max_depth.unwrap_or(DEFAULT_MAX_DEPTH),
+        samples: file.samples,
         lights,
         materials,
         objects,
@@ -504,6 +519,7 @@ pub fn scene_to_file(scene: &Scene) -> Result<SceneFile, String> {
         background: tc(scene.background),
         ambient: Some(scene.ambient),
         max_depth: Some(scene.max_depth),
+        samples: scene.samples,
         lights: scene
             .lights
             .iter()
