@@ -109,7 +109,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         .into());
     }
     let pool = thread_pool(args.threads)?;
-    let mut prepared = prepare(&args.scene, &args.kernel)?;
+    let mut prepared = prepare(&args.scene, &args.mesh, &args.kernel)?;
     let scene = &mut prepared.scene;
     args.size.apply(&mut scene.camera)?;
     let precision = precision(&args.kernel, &scene.camera)?;

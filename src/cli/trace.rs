@@ -11,9 +11,9 @@ use crate::accel::scene::{Precision, QueryStats, SceneGeometry, SceneHit};
 use crate::cli::args::TraceArgs;
 use crate::cli::setup::{precision, prepare, thread_pool};
 use crate::geom::Ray;
-use crate::scene::LoadError;
 use crate::scene::rays::{RayChunks, RayQuery};
 use crate::scene::write::write_atomic;
+use crate::scene::{LoadError, Scene};
 
 /// The header line of the contract.
 pub const TRACE_HEADER: &str = "ray,hit,t,object,patch,u,v,px,py,pz,nx,ny,nz";
@@ -26,7 +26,7 @@ pub const CHUNK_RAYS: usize = 1 << 16;
 pub fn run(args: TraceArgs) -> anyhow::Result<ExitCode> {
     let file = std::fs::File::open(&args.rays).map_err(|e| LoadError::io(&args.rays, e))?;
     let mut rays = RayChunks::new(&args.rays, std::io::BufReader::new(file));
-    let prepared = prepare(&args.scene, &args.kernel)?;
+    let prepared = prepare(&args.scene, &args.mesh, &args.kernel)?;
     let precision = precision(&args.kernel, &prepared.scene.camera)?;
     let pool = thread_pool(args.threads)?;
     // A bad line found mid-file stops the output; the error is kept here because the
@@ -48,7 +48,11 @@ pub fn run(args: TraceArgs) -> anyhow::Result<ExitCode> {
                 chunk
                     .par_iter()
                     .enumerate()
-                    .map(|(i, q)| row(first + i, trace_one(&prepared.geometry, q, &precision)))
+                    .map(|(i, q)| {
+                        let hit = trace_one(&prepared.geometry, q, &precision)
+                            .map(|(h, o, d)| (in_contract_terms(&prepared.scene, h), o, d));
+                        row(first + i, hit)
+                    })
                     .collect()
             });
             for r in &rows {
@@ -93,6 +97,15 @@ fn trace_one(
             Some((hit, q.origin, q.dir))
         }
     }
+}
+
+/// The hit with the patch and (u, v) the contract reports: for a subdivision surface the
+/// quad after the first Catmull–Clark step ([`crate::scene::Object::trace_patch`]).
+fn in_contract_terms(scene: &Scene, mut hit: SceneHit) -> SceneHit {
+    if let Some(object) = scene.objects.get(hit.object as usize) {
+        (hit.patch, hit.u, hit.v) = object.trace_patch(hit.patch, hit.u, hit.v);
+    }
+    hit
 }
 
 fn row(index: usize, hit: Option<(SceneHit, DVec3, DVec3)>) -> String {

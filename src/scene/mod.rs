@@ -4,6 +4,7 @@
 //! expected`; every writer writes to a temporary name and renames.
 
 pub mod bpt;
+pub mod cage;
 pub mod convert;
 pub mod error;
 pub mod generate;
@@ -21,5 +22,5 @@ pub mod text;
 pub mod write;
 
 pub use error::{LoadError, ParseError};
-pub use load::{load_geometry, load_scene};
+pub use load::{LoadOptions, load_geometry, load_scene, load_scene_with, load_subdivision};
 pub use model::*;

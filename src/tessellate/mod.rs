@@ -192,6 +192,7 @@ fn object_within(
             }
             patches_within(&object.bezier_patches(), mode, budget, patch_done)?.mesh
         }
+        Geometry::Subdivision(_) => tessellate_patches(&object.bezier_patches(), mode)?.mesh,
     };
     let report = TessellationReport::of(&mesh);
     Ok((
