@@ -37,6 +37,19 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
             "  {}: material \"{}\", {} surface(s), {} NURBS, {} patch(es), {} trim loop(s), {} triangle(s)",
             o.name, o.material, o.surfaces, o.nurbs_surfaces, o.patches, o.trim_loops, o.triangles
         )?;
+        if let Some(sd) = &o.subdivision {
+            writeln!(
+                out,
+                "    Catmull–Clark cage: {} vertices, {} faces -> {} quads; {} regular patches, {} extraordinary ends, {} T-junctions, {} levels",
+                sd.cage_vertices,
+                sd.cage_faces,
+                sd.quads,
+                sd.regular_patches,
+                sd.extraordinary_ends,
+                sd.t_junctions,
+                sd.levels
+            )?;
+        }
     }
     let degrees: Vec<String> = s.degrees.iter().map(|(d, n)| format!("{d}: {n}")).collect();
     writeln!(

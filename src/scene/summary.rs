@@ -33,9 +33,26 @@ pub struct CameraSummary {
     pub height: u32,
 }
 
+/// A Catmull–Clark surface's construction (see [`crate::geom::subdiv::Stats`]).
+#[derive(Debug, Serialize)]
+pub struct SubdivisionSummary {
+    pub cage_vertices: usize,
+    pub cage_faces: usize,
+    /// Quads after the first Catmull–Clark step (the `trace` patch numbers).
+    pub quads: usize,
+    pub regular_patches: usize,
+    /// Final children at extraordinary vertices.
+    pub extraordinary_ends: usize,
+    pub t_junctions: usize,
+    /// Deepest refinement level (1: every quad regular).
+    pub levels: u32,
+}
+
 #[derive(Debug, Serialize)]
 pub struct ObjectSummary {
     pub name: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub subdivision: Option<SubdivisionSummary>,
     pub material: String,
     pub surfaces: usize,
     pub nurbs_surfaces: usize,
@@ -71,8 +88,21 @@ pub fn summarize(scene: &Scene) -> SceneSummary {
         patches += bez.len();
         nurbs += n;
         triangles += tris;
+        let subdivision = match &o.geometry {
+            Geometry::Subdivision(sd) => Some(SubdivisionSummary {
+                cage_vertices: sd.cage.points.len(),
+                cage_faces: sd.stats.cage_faces,
+                quads: sd.stats.faces,
+                regular_patches: sd.stats.regular,
+                extraordinary_ends: sd.stats.extraordinary_ends,
+                t_junctions: sd.stats.t_junctions,
+                levels: sd.stats.levels,
+            }),
+            _ => None,
+        };
         objects.push(ObjectSummary {
             name: o.name.clone(),
+            subdivision,
             material: scene
                 .materials
                 .get(o.material)
