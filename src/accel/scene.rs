@@ -187,7 +187,28 @@ impl LeafPacks {
 /// The nearest candidate found so far during traversal.
 enum Candidate {
     Patch(u32, PatchHit),
+    /// A hit of the `f32` subdivision kernel, whose world hit box is made only for the
+    /// nearest ([`subdivision::KernelHit`]).
+    Subdivision(u32, subdivision::KernelHit),
     Triangle(u32, TriangleHit),
+}
+
+/// The ray as the `f32` subdivision kernel takes it, made at the first patch test of a
+/// query (most rays that miss never reach one) and shared by every patch it meets.
+struct PatchRay<'a> {
+    ray: &'a Ray,
+    kernel: Option<subdivision::KernelRay>,
+}
+
+impl<'a> PatchRay<'a> {
+    fn new(ray: &'a Ray) -> Self {
+        PatchRay { ray, kernel: None }
+    }
+
+    fn kernel(&mut self, cfg: &SubdivisionConfig) -> &subdivision::KernelRay {
+        self.kernel
+            .get_or_insert_with(|| subdivision::KernelRay::new(self.ray, cfg))
+    }
 }
 
 /// The acceleration structure over the primitives.
@@ -322,13 +343,25 @@ impl SceneGeometry {
         precision: &Precision,
         stats: &mut QueryStats,
     ) -> Option<SceneHit> {
+        let mut patch_ray = PatchRay::new(ray);
         let best = match &self.accel {
-            Accel::Bvh(bvh, packs) => self.nearest_in_bvh(bvh, packs, ray, precision, stats),
-            Accel::Grid(grid) => self.nearest_in_grid(grid, ray, precision, stats),
+            Accel::Bvh(bvh, packs) => {
+                self.nearest_in_bvh(bvh, packs, &mut patch_ray, precision, stats)
+            }
+            Accel::Grid(grid) => self.nearest_in_grid(grid, &mut patch_ray, precision, stats),
         };
         Some(match best? {
             Candidate::Patch(prim, h) => {
                 self.finish_patch_hit(prim, h.t as f64, h.u as f64, h.v as f64, h.hit_box)
+            }
+            Candidate::Subdivision(prim, h) => {
+                // The test that found `h` made the kernel ray.
+                let hit_box = patch_ray
+                    .kernel
+                    .as_ref()
+                    .map_or(Aabb::EMPTY, |k| k.hit_box(&h));
+                let (u, v) = h.uv();
+                self.finish_patch_hit(prim, h.t() as f64, u, v, hit_box)
             }
             Candidate::Triangle(k, h) => self.finish_triangle_hit(k, &h),
         })
@@ -405,10 +438,11 @@ impl SceneGeometry {
         &self,
         bvh: &Bvh,
         packs: &LeafPacks,
-        ray: &Ray,
+        patch_ray: &mut PatchRay,
         precision: &Precision,
         stats: &mut QueryStats,
     ) -> Option<Candidate> {
+        let ray = patch_ray.ray;
         let mut best = None;
         // The kernel counters borrowed apart from the traversal counters the closure leaves.
         let kernel = &mut stats.kernel;
@@ -423,13 +457,11 @@ impl SceneGeometry {
                     if prim >= patches {
                         continue;
                     }
-                    let r = Ray {
-                        tmax: *tmax,
-                        ..*ray
-                    };
-                    if let Some(hit) = self.patch_hit(prim, &r, precision, kernel) {
-                        *tmax = tmax.min(hit.t);
-                        best = Some(Candidate::Patch(prim, hit));
+                    if let Some((t, hit)) =
+                        self.patch_hit(prim, patch_ray, *tmax, precision, kernel)
+                    {
+                        *tmax = tmax.min(t);
+                        best = Some(hit);
                     }
                 }
             }
@@ -465,17 +497,17 @@ impl SceneGeometry {
         let shear = PackShear::new(&RayShear::new(ray));
         let patches = self.prepared.len() as u32;
         let kernel = &mut stats.kernel;
+        let mut patch_ray = PatchRay::new(ray);
         let mut hit = false;
         let mut surface_tests = 0;
         let t = bvh.traverse_leaves(ray, |range, _| {
             surface_tests += range.len() as u64;
-            hit = bvh.prim_indices()[range.clone()]
-                .iter()
-                .any(|&prim| prim < patches && self.patch_occluded(prim, ray, precision, kernel))
-                || packs.of_leaf(&range).1.iter().any(|pack| {
-                    kernel.patch_tests += 1;
-                    intersect_pack(&shear, pack, ray.tmin, ray.tmax).mask != 0
-                });
+            hit = bvh.prim_indices()[range.clone()].iter().any(|&prim| {
+                prim < patches && self.patch_occluded(prim, &mut patch_ray, precision, kernel)
+            }) || packs.of_leaf(&range).1.iter().any(|pack| {
+                kernel.patch_tests += 1;
+                intersect_pack(&shear, pack, ray.tmin, ray.tmax).mask != 0
+            });
             if hit {
                 ControlFlow::Break(())
             } else {
@@ -492,10 +524,11 @@ impl SceneGeometry {
     fn nearest_in_grid(
         &self,
         grid: &Grid,
-        ray: &Ray,
+        patch_ray: &mut PatchRay,
         precision: &Precision,
         stats: &mut QueryStats,
     ) -> Option<Candidate> {
+        let ray = patch_ray.ray;
         let mut best = None;
         let kernel = &mut stats.kernel;
         let shear = RayShear::new(ray);
@@ -503,10 +536,9 @@ impl SceneGeometry {
         let g = grid.traverse(ray, |prim, tmax| {
             kernel.patch_tests += (prim >= patches) as u64;
             if prim < patches {
-                let r = Ray { tmax, ..*ray };
-                let hit = self.patch_hit(prim, &r, precision, kernel)?;
-                best = Some(Candidate::Patch(prim, hit));
-                Some(hit.t)
+                let (t, hit) = self.patch_hit(prim, patch_ray, tmax, precision, kernel)?;
+                best = Some(hit);
+                Some(t)
             } else {
                 let k = prim - patches;
                 let [a, b, c] = self.triangles.corners[k as usize];
@@ -532,9 +564,10 @@ impl SceneGeometry {
         let shear = RayShear::new(ray);
         let patches = self.prepared.len() as u32;
         let kernel = &mut stats.kernel;
+        let mut patch_ray = PatchRay::new(ray);
         let (hit, g) = grid.traverse_any(ray, |prim| {
             if prim < patches {
-                self.patch_occluded(prim, ray, precision, kernel)
+                self.patch_occluded(prim, &mut patch_ray, precision, kernel)
             } else {
                 kernel.patch_tests += 1;
                 let [a, b, c] = self.triangles.corners[(prim - patches) as usize];
@@ -547,48 +580,56 @@ impl SceneGeometry {
         hit
     }
 
-    /// Nearest hit on patch `prim` by the `f32`-ray kernel `precision` selects.
+    /// Nearest hit on patch `prim` with `t` up to `tmax` by the `f32`-ray kernel
+    /// `precision` selects, and its `t`.
     fn patch_hit(
         &self,
         prim: u32,
-        ray: &Ray,
+        ray: &mut PatchRay,
+        tmax: f32,
         precision: &Precision,
         kernel: &mut KernelStats,
-    ) -> Option<PatchHit> {
+    ) -> Option<(f32, Candidate)> {
+        let patch_hit = |h: PatchHit| (h.t, Candidate::Patch(prim, h));
+        let r = Ray { tmax, ..*ray.ray };
         match precision {
             Precision::Toth(cfg) => {
                 let origin = cfg.surface_of_origin == Some(prim);
-                toth::intersect(&self.originals[prim as usize], ray, cfg, origin, kernel)
+                toth::intersect(&self.originals[prim as usize], &r, cfg, origin, kernel)
+                    .map(patch_hit)
             }
             Precision::Cached(cfg) => {
                 let origin = cfg.toth.surface_of_origin == Some(prim);
-                cached::intersect(&self.originals[prim as usize], ray, cfg, origin, kernel)
+                cached::intersect(&self.originals[prim as usize], &r, cfg, origin, kernel)
+                    .map(patch_hit)
             }
             Precision::F32(cfg) | Precision::F64(cfg) => {
-                subdivision::intersect(&self.prepared[prim as usize], ray, cfg, kernel)
+                let patch = &self.prepared[prim as usize];
+                subdivision::nearest(patch, ray.kernel(cfg), tmax, cfg, kernel)
+                    .map(|h| (h.t(), Candidate::Subdivision(prim, h)))
             }
         }
     }
 
-    /// Whether patch `prim` blocks `ray`, by the kernel `precision` selects.
+    /// Whether patch `prim` blocks the ray, by the kernel `precision` selects.
     fn patch_occluded(
         &self,
         prim: u32,
-        ray: &Ray,
+        ray: &mut PatchRay,
         precision: &Precision,
         kernel: &mut KernelStats,
     ) -> bool {
         match precision {
             Precision::Toth(cfg) => {
                 let origin = cfg.surface_of_origin == Some(prim);
-                toth::occluded(&self.originals[prim as usize], ray, cfg, origin, kernel)
+                toth::occluded(&self.originals[prim as usize], ray.ray, cfg, origin, kernel)
             }
             Precision::Cached(cfg) => {
                 let origin = cfg.toth.surface_of_origin == Some(prim);
-                cached::occluded(&self.originals[prim as usize], ray, cfg, origin, kernel)
+                cached::occluded(&self.originals[prim as usize], ray.ray, cfg, origin, kernel)
             }
             Precision::F32(cfg) | Precision::F64(cfg) => {
-                subdivision::occluded(&self.prepared[prim as usize], ray, cfg, kernel)
+                subdivision::blocks(&self.prepared[prim as usize], ray.kernel(cfg), cfg, kernel)
             }
         }
     }

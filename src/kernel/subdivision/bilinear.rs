@@ -139,7 +139,7 @@ mod tests {
     #[test]
     fn hits_match_the_general_path_on_random_rays() {
         let p = patch();
-        let fast = PreparedPatch::new(&p);
+        let fast = PreparedPatch::bilinear(&p).expect("a bilinear patch");
         assert!(matches!(fast.data, Prepared::Bilinear(_)));
         let general = PreparedPatch::general(&p);
         let cfg = SubdivisionConfig::default();

@@ -19,6 +19,7 @@ use super::float::{GBox, GRay};
 use super::heuristics::Corners;
 use super::jump::JumpOutcome;
 use super::param::{ParamCell, Split};
+use super::ray_space::RayFrame;
 use super::search::{NetStack, Node, SearchHit, search};
 use crate::geom::bbox::slab;
 use crate::kernel::KernelStats;
@@ -221,12 +222,14 @@ impl<N: RegisterNet> NetStack<f32> for RegisterStack<'_, N> {
     }
 }
 
-/// What one search of a register net is asked: the net's root box, the ray, the settings,
-/// and whether any hit will do (shadow rays).
+/// What one search of a register net is asked: the net's root box, the ray (and its
+/// ray-space frame where the ray is searched in ray space, which only the AVX-512 net
+/// supports), the settings, and whether any hit will do (shadow rays).
 #[derive(Clone, Copy, Debug)]
 pub struct Query<'a> {
     pub root: GBox<f32>,
     pub ray: &'a GRay<f32>,
+    pub frame: Option<&'a RayFrame>,
     pub cfg: &'a SubdivisionConfig,
     pub any_hit: bool,
 }

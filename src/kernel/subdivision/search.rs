@@ -437,8 +437,9 @@ mod tests {
     fn grazing_ray_splits_stay_within_the_bound_and_hit_within_the_box() {
         // About 1/GRAZING_ANGLE boxes per level along the stretch where the ray runs
         // within a box size of the plane.
-        // In world space (secondary rays): a primary ray's ray-space boxes are tight across
-        // the ray, so there the same ray needs few splits (checked below).
+        // In world space (the search of paths without ray space, such as CPUs without
+        // AVX-512): ray-space boxes are tight across the ray, so there the same ray needs
+        // few splits (checked below).
         let ray = grazing_ray(GRAZING_ANGLE);
         let world = SubdivisionConfig {
             ray_space: false,
