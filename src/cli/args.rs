@@ -149,7 +149,9 @@ pub struct TeapotsArgs {
 
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// Scene (.ron) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb).
+    /// Scene (.ron) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb, .step, .stp). For a
+    /// STEP file, also its schema, units, faces converted or not, projected edges and the
+    /// largest projection error, and unsupported entities by type.
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
@@ -160,7 +162,7 @@ pub struct InfoArgs {
 
 #[derive(Debug, Args)]
 pub struct ImportArgs {
-    /// Input scene or geometry file.
+    /// Input scene or geometry file (any SCENE input, STEP included).
     pub input: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use super::error::LoadError;
 use super::model::{Geometry, Object, Scene, Surface};
-use super::{bpt, cage, gltf_mesh, mesh, obj, pbrt, ron_format};
+use super::{bpt, cage, gltf_mesh, mesh, obj, pbrt, ron_format, step};
 
 /// The kinds of input file we read, by extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -14,6 +14,7 @@ pub enum InputKind {
     Obj,
     Pbrt,
     Gltf,
+    Step,
 }
 
 impl InputKind {
@@ -25,6 +26,7 @@ impl InputKind {
             "obj" => InputKind::Obj,
             "pbrt" => InputKind::Pbrt,
             "gltf" | "glb" => InputKind::Gltf,
+            "step" | "stp" => InputKind::Step,
             _ => return None,
         })
     }
@@ -33,7 +35,7 @@ impl InputKind {
 fn unknown_kind(path: &Path) -> LoadError {
     LoadError::invalid(
         path,
-        "unknown file type: expected .ron (scene), .bpt, .obj, .pbrt, .gltf or .glb",
+        "unknown file type: expected .ron (scene), .bpt, .obj, .pbrt, .gltf, .glb, .step or .stp",
     )
 }
 
@@ -59,6 +61,7 @@ pub fn load_geometry(path: &Path) -> Result<Geometry, LoadError> {
             Ok(Geometry::Surfaces(pbrt::parse_pbrt(path, &src)?))
         }
         InputKind::Gltf => Ok(Geometry::Mesh(gltf_mesh::read_gltf(path)?)),
+        InputKind::Step => step::load_geometry(path),
         InputKind::Ron => Err(LoadError::invalid(
             path,
             "a scene cannot be used as geometry; reference its geometry files instead",
@@ -91,6 +94,7 @@ pub fn load_subdivision(path: &Path) -> Result<Geometry, LoadError> {
         InputKind::Bpt => Err(refuse("a .bpt file of Bézier patches")),
         InputKind::Pbrt => Err(refuse("a pbrt file")),
         InputKind::Ron => Err(refuse("a RON scene")),
+        InputKind::Step => Err(refuse("a STEP file")),
     }
 }
 
@@ -109,19 +113,36 @@ pub fn load_scene(path: &Path) -> Result<Scene, LoadError> {
 
 /// [`load_scene`] with options for bare geometry.
 pub fn load_scene_with(path: &Path, options: LoadOptions) -> Result<Scene, LoadError> {
-    let scene = if options.subdivide {
+    Ok(load_scene_noted(path, options)?.0)
+}
+
+/// [`load_scene_with`], with what the reader noted about the file beyond the scene (a
+/// STEP file's units, unsupported entities, faces left out), one line each, for `info`.
+pub fn load_scene_noted(
+    path: &Path,
+    options: LoadOptions,
+) -> Result<(Scene, Vec<String>), LoadError> {
+    let (scene, notes) = if options.subdivide {
         if InputKind::of(path) == Some(InputKind::Ron) {
             return Err(LoadError::invalid(
                 path,
                 "--subdivide applies to bare mesh files; in a RON scene write `geometry: Subdivision(File(\"cage.obj\"))`",
             ));
         }
-        bare_scene(path, load_subdivision(path)?)
+        (bare_scene(path, load_subdivision(path)?), Vec::new())
+    } else if InputKind::of(path) == Some(InputKind::Step) {
+        let model = step::read_step(path)?;
+        if let Some(w) = model.report.warning(path) {
+            eprintln!("{w}");
+        }
+        let mut scene = Scene::framing(model.objects);
+        scene.materials = model.materials;
+        (scene, model.report.lines())
     } else {
-        read_any_scene(path)?
+        (read_any_scene(path)?, Vec::new())
     };
     check_f32_range(path, &scene)?;
-    Ok(scene)
+    Ok((scene, notes))
 }
 
 /// Smallest object extent the renderer accepts: 2^-60 ≈ 8.7e-19. Shading squares

@@ -17,6 +17,7 @@ pub mod pbrt;
 pub mod rays;
 pub mod ron_format;
 pub mod ron_locate;
+pub mod step;
 pub mod summary;
 pub mod text;
 pub mod write;
