@@ -63,6 +63,8 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     let pool = thread_pool(args.threads)?;
     let mut scene = load_scene_with(&args.scene, args.mesh.load_options())?;
     args.size.apply(&mut scene.camera)?;
+    crate::scene::check_film_pixels(scene.camera.width, scene.camera.height)
+        .map_err(crate::cli::BadArgument)?;
     std::fs::create_dir_all(&args.out_dir)
         .with_context(|| format!("creating {}", args.out_dir.display()))?;
     if !args.quiet {

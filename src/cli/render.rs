@@ -141,6 +141,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         (None, Some(tile)) => Window::tile(tile, width, height).map_err(anyhow::Error::msg)?,
         (None, None) => Window::full(width, height),
     };
+    crate::scene::check_film_pixels(window.width(), window.height())
+        .map_err(crate::cli::BadArgument)?;
     let job = RenderJob {
         order: args.order,
         samples,

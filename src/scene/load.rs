@@ -4,7 +4,7 @@ use std::path::Path;
 
 use super::error::LoadError;
 use super::model::{Geometry, Object, Scene, Surface};
-use super::{bpt, cage, mesh, obj, pbrt, ron_format, step};
+use super::{bpt, cage, gltf_mesh, mesh, obj, pbrt, ron_format, step};
 
 /// The kinds of input file we read, by extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -60,7 +60,7 @@ pub fn load_geometry(path: &Path) -> Result<Geometry, LoadError> {
             let src = super::error::read_text(path)?;
             Ok(Geometry::Surfaces(pbrt::parse_pbrt(path, &src)?))
         }
-        InputKind::Gltf => Ok(Geometry::Mesh(mesh::read_gltf(path)?)),
+        InputKind::Gltf => Ok(Geometry::Mesh(gltf_mesh::read_gltf(path)?)),
         InputKind::Step => step::load_geometry(path),
         InputKind::Ron => Err(LoadError::invalid(
             path,
@@ -89,7 +89,7 @@ pub fn load_subdivision(path: &Path) -> Result<Geometry, LoadError> {
         }
         InputKind::Gltf => Ok(Geometry::Subdivision(cage::mesh_cage(
             path,
-            &mesh::read_gltf(path)?,
+            &gltf_mesh::read_gltf(path)?,
         )?)),
         InputKind::Bpt => Err(refuse("a .bpt file of Bézier patches")),
         InputKind::Pbrt => Err(refuse("a pbrt file")),
@@ -192,16 +192,31 @@ pub fn check_f32_range(path: &Path, scene: &Scene) -> Result<(), LoadError> {
             ));
         }
         let largest = b.min.abs().max(b.max.abs()).max_element();
-        if !((largest as f32).is_finite()) {
+        // Box arithmetic (slab tests, extents, the default camera's distance) works on
+        // differences of coordinates, so the extent must fit as well: a patch at ±3e38
+        // has finite corners but an infinite f32 width.
+        if !((largest as f32).is_finite()) || !((extent as f32).is_finite()) {
             return Err(LoadError::invalid(
                 path,
                 format!(
-                    "object \"{}\": coordinates reach {largest:e} after transforms, beyond the f32 range (±{:e}) the renderer works in",
+                    "object \"{}\": coordinates reach {largest:e} and the box spans {extent:e} after transforms, beyond the f32 range (±{:e}) the renderer works in; scale the scene down",
                     o.name,
                     f32::MAX
                 ),
             ));
         }
+    }
+    let c = &scene.camera;
+    if !(c.eye.as_vec3().is_finite() && c.look_at.as_vec3().is_finite()) {
+        return Err(LoadError::invalid(
+            path,
+            format!(
+                "camera: eye {} or look_at {} is beyond the f32 range (±{:e}) the renderer works in",
+                c.eye,
+                c.look_at,
+                f32::MAX
+            ),
+        ));
     }
     Ok(())
 }

@@ -1,6 +1,6 @@
 //! The scene model and one reader/writer per format: our RON scene, `.bpt` Bézier patch
 //! files, Wavefront OBJ free-form surfaces, pbrt-v3 `Shape "nurbs"`, and triangle meshes
-//! (OBJ via tobj, glTF via gltf). Every reader reports errors as `file:line:col: what was
+//! (polygonal OBJ, glTF and GLB). Every reader reports errors as `file:line:col: what was
 //! expected`; every writer writes to a temporary name and renames.
 
 pub mod bpt;
@@ -8,6 +8,7 @@ pub mod cage;
 pub mod convert;
 pub mod error;
 pub mod generate;
+pub mod gltf_mesh;
 pub mod load;
 pub mod mesh;
 pub mod model;
@@ -15,6 +16,7 @@ pub mod obj;
 pub mod pbrt;
 pub mod rays;
 pub mod ron_format;
+pub mod ron_locate;
 pub mod step;
 pub mod summary;
 pub mod text;

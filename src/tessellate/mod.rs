@@ -56,7 +56,22 @@ pub enum TessellateError {
     TooManyVertices,
     #[error("object {0:?} has trimmed surfaces, which the tessellator does not support yet")]
     Trimmed(String),
+    #[error(
+        "the tessellation would reach {triangles} triangles by patch {patch} of object {object:?}, above the budget of {budget} (2^24 triangles, about 1 GB with their vertices); use a coarser --grid or --triangles-per-patch, or a larger --tolerance"
+    )]
+    Budget {
+        object: String,
+        patch: u32,
+        triangles: u64,
+        budget: u64,
+    },
 }
+
+/// Most triangles one tessellation may make: 2^24 (16.7 M), 12 bytes of indices each plus
+/// about half a vertex each (24 bytes, and the welding map's entry), about 1 GB in all.
+/// Dammertz's finest table row (131072 per patch) on the 32-patch teapot is 4.2 M;
+/// `--grid 100000,100000` asked for 40 GB (issue 21).
+pub const MAX_TRIANGLES: u64 = 1 << 24;
 
 /// Size of a tessellation. `bytes` is the memory the triangle path renders from: `f32`
 /// positions and normals (24 bytes per vertex) and `u32` indices (12 bytes per triangle).
@@ -113,10 +128,24 @@ pub fn tessellate_scene(
     scene: &Scene,
     mode: TessellationMode,
 ) -> Result<(Scene, TessellationReport), TessellateError> {
+    tessellate_scene_with(scene, mode, &mut || {})
+}
+
+/// [`tessellate_scene`], calling `patch_done()` after each patch, for a progress bar. The
+/// scene's triangles stay within [`MAX_TRIANGLES`] in all.
+pub fn tessellate_scene_with(
+    scene: &Scene,
+    mode: TessellationMode,
+    patch_done: &mut dyn FnMut(),
+) -> Result<(Scene, TessellationReport), TessellateError> {
     let mut report = TessellationReport::default();
     let mut objects = Vec::with_capacity(scene.objects.len());
     for object in &scene.objects {
-        let (o, r) = tessellate_object(object, mode)?;
+        let budget = Budget {
+            object: &object.name,
+            triangles: MAX_TRIANGLES.saturating_sub(report.triangles),
+        };
+        let (o, r) = object_within(object, mode, budget, patch_done)?;
         report.add(&r);
         objects.push(o);
     }
@@ -134,13 +163,34 @@ pub fn tessellate_object(
     object: &Object,
     mode: TessellationMode,
 ) -> Result<(Object, TessellationReport), TessellateError> {
+    let budget = Budget {
+        object: &object.name,
+        triangles: MAX_TRIANGLES,
+    };
+    object_within(object, mode, budget, &mut || {})
+}
+
+/// How many more triangles a tessellation may make, and the object named when it would
+/// make more.
+#[derive(Clone, Copy)]
+struct Budget<'a> {
+    object: &'a str,
+    triangles: u64,
+}
+
+fn object_within(
+    object: &Object,
+    mode: TessellationMode,
+    budget: Budget,
+    patch_done: &mut dyn FnMut(),
+) -> Result<(Object, TessellationReport), TessellateError> {
     let mesh = match &object.geometry {
         Geometry::Mesh(m) => m.clone(),
         Geometry::Surfaces(surfaces) => {
             if surfaces.iter().any(|s| !s.trims.is_empty()) {
                 return Err(TessellateError::Trimmed(object.name.clone()));
             }
-            tessellate_patches(&object.bezier_patches(), mode)?.mesh
+            patches_within(&object.bezier_patches(), mode, budget, patch_done)?.mesh
         }
         Geometry::Subdivision(_) => tessellate_patches(&object.bezier_patches(), mode)?.mesh,
     };
@@ -159,10 +209,24 @@ pub fn tessellate_patches(
     patches: &[BezierPatch],
     mode: TessellationMode,
 ) -> Result<PatchMesh, TessellateError> {
+    let budget = Budget {
+        object: "",
+        triangles: MAX_TRIANGLES,
+    };
+    patches_within(patches, mode, budget, &mut || {})
+}
+
+fn patches_within(
+    patches: &[BezierPatch],
+    mode: TessellationMode,
+    budget: Budget,
+    patch_done: &mut dyn FnMut(),
+) -> Result<PatchMesh, TessellateError> {
     let plan = Plan::new(mode)?;
     let mut t = Tessellator::default();
     for (index, patch) in patches.iter().enumerate() {
-        t.patch(index as u32, patch, plan)?;
+        t.patch(index as u32, patch, plan, budget)?;
+        patch_done();
     }
     Ok(t.out)
 }
@@ -233,6 +297,7 @@ impl Tessellator {
         index: u32,
         patch: &BezierPatch,
         plan: Plan,
+        budget: Budget,
     ) -> Result<(), TessellateError> {
         let curves = Side::ALL.map(|s| EdgeCurve::of(patch, s));
         let (mut grid_u, mut grid_v, wanted) = match plan {
@@ -258,6 +323,17 @@ impl Tessellator {
             // The ring stitch needs at least one interior grid point.
             grid_u = grid_u.max(2);
             grid_v = grid_v.max(2);
+        }
+        // Checked before the grid is made: the interior grid alone is (g_u + 1)(g_v + 1)
+        // vertices, so an absurd grid must be refused before its allocation.
+        let triangles = self.out.mesh.indices.len() as u64 + 2 * grid_u as u64 * grid_v as u64;
+        if triangles > budget.triangles {
+            return Err(TessellateError::Budget {
+                object: budget.object.to_string(),
+                patch: index,
+                triangles: triangles + (MAX_TRIANGLES - budget.triangles),
+                budget: MAX_TRIANGLES,
+            });
         }
         let mut interior = vec![0u32; (grid_u + 1) * (grid_v + 1)];
         for j in 1..grid_v {
