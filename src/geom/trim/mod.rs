@@ -22,7 +22,7 @@ pub mod region;
 pub use axis_map::AxisMap;
 pub use region::{Coverage, PatchTrim, TrimError, TrimRegion};
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 /// A planar parameter-space curve (OBJ `curv2`) as a B-spline: homogeneous premultiplied
 /// points `(w u, w v, w)` (w = 1 for non-rational) and a knot vector of
@@ -49,4 +49,66 @@ pub struct TrimSegment {
 pub struct TrimLoop {
     pub hole: bool,
     pub segments: Vec<TrimSegment>,
+}
+
+impl ParamCurve {
+    /// The circle of radius `r` about `c`, once counter-clockwise from angle 0 over
+    /// `[0, 1]`: the 9-point rational quadratic of Piegl & Tiller §7.5 (four quadrants,
+    /// corner weights √2/2), exact.
+    pub fn circle(c: DVec2, r: f64) -> ParamCurve {
+        let w = std::f64::consts::FRAC_1_SQRT_2;
+        let unit = [
+            (1., 0., 1.),
+            (1., 1., w),
+            (0., 1., 1.),
+            (-1., 1., w),
+            (-1., 0., 1.),
+            (-1., -1., w),
+            (0., -1., 1.),
+            (1., -1., w),
+            (1., 0., 1.),
+        ];
+        ParamCurve {
+            degree: 2,
+            knots: vec![0., 0., 0., 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1., 1., 1.],
+            points: unit
+                .iter()
+                .map(|&(x, y, w)| DVec3::new((c.x + r * x) * w, (c.y + r * y) * w, w))
+                .collect(),
+        }
+    }
+
+    /// The closed polygon through `corners` (the first repeated at the end) as a degree-1
+    /// curve over `[0, 1]`.
+    pub fn polygon(corners: &[DVec2]) -> ParamCurve {
+        let n = corners.len() + 1;
+        let mut knots = vec![0.0];
+        knots.extend((0..n).map(|i| i as f64 / (n - 1) as f64));
+        knots.push(1.0);
+        ParamCurve {
+            degree: 1,
+            knots,
+            points: corners
+                .iter()
+                .chain(corners.first())
+                .map(|p| p.extend(1.0))
+                .collect(),
+        }
+    }
+
+    /// The curve's parameter domain.
+    pub fn domain(&self) -> (f64, f64) {
+        crate::geom::nurbs::knots::domain(self.degree, &self.knots)
+    }
+}
+
+impl TrimLoop {
+    /// A loop of one closed curve, taken over its whole domain.
+    pub fn closed(curve: ParamCurve, hole: bool) -> TrimLoop {
+        let (t0, t1) = curve.domain();
+        TrimLoop {
+            hole,
+            segments: vec![TrimSegment { t0, t1, curve }],
+        }
+    }
 }

@@ -195,33 +195,12 @@ fn segment_pieces(curve: &super::ParamCurve, t0: f64, t1: f64) -> Result<Vec<Pie
 }
 
 #[cfg(test)]
-pub(crate) mod tests {
+mod tests {
     use super::*;
     use crate::geom::trim::{ParamCurve, TrimSegment};
 
-    /// The unit circle as the 9-point rational quadratic B-spline (Piegl & Tiller §7.5),
-    /// homogeneous, scaled by `r` around `c`.
-    pub fn circle(c: DVec2, r: f64) -> ParamCurve {
-        let w = std::f64::consts::FRAC_1_SQRT_2;
-        let pts = [
-            (1., 0., 1.),
-            (1., 1., w),
-            (0., 1., 1.),
-            (-1., 1., w),
-            (-1., 0., 1.),
-            (-1., -1., w),
-            (0., -1., 1.),
-            (1., -1., w),
-            (1., 0., 1.),
-        ];
-        ParamCurve {
-            degree: 2,
-            knots: vec![0., 0., 0., 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1., 1., 1.],
-            points: pts
-                .iter()
-                .map(|&(x, y, w)| DVec3::new((c.x + r * x) * w, (c.y + r * y) * w, w))
-                .collect(),
-        }
+    fn circle(c: DVec2, r: f64) -> ParamCurve {
+        ParamCurve::circle(c, r)
     }
 
     #[test]

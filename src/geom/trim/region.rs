@@ -3,7 +3,10 @@
 //!
 //! A point (u, v) of the trim parameter space is kept when the half-line from it toward +u
 //! crosses the pieces of all loops an odd number of times (even–odd rule: outer loops,
-//! holes and islands in holes need no orientation or nesting information).
+//! holes and islands in holes need no orientation or nesting information). Where every loop
+//! is a hole, the domain's boundary is the outer loop (OBJ `hole` without `trim`, an IGES
+//! 144 whose outer boundary is the domain's): every point of the domain lies inside that
+//! boundary, so the parity is inverted rather than the boundary traced.
 //!
 //! Culling (issue 15): for a patch covering the rectangle R of the trim space, only pieces
 //! that can cross a half-line starting in R matter: a piece wholly left of R, above it or
@@ -30,6 +33,8 @@ pub enum TrimError {
 pub struct TrimRegion {
     pieces: Vec<Piece>,
     map: [AxisMap; 2],
+    /// No outer loop: the domain's boundary is one (module docs).
+    outer_is_domain: bool,
 }
 
 /// How a patch's rectangle relates to a region.
@@ -55,6 +60,7 @@ pub struct PatchTrim {
     hi: DVec2,
     near: Vec<Piece>,
     far: Vec<(DVec2, DVec2)>,
+    outer_is_domain: bool,
 }
 
 impl TrimRegion {
@@ -70,6 +76,7 @@ impl TrimRegion {
         Ok(Some(TrimRegion {
             pieces,
             map: map.clone(),
+            outer_is_domain: loops.iter().all(|l| l.hole),
         }))
     }
 
@@ -92,7 +99,8 @@ impl TrimRegion {
     /// Whether the surface exists at (u, v), in the surface's own parameters.
     pub fn contains(&self, u: f64, v: f64) -> bool {
         let p = DVec2::new(self.map[0].apply(u), self.map[1].apply(v));
-        self.pieces.iter().filter(|q| crosses_odd(q, p)).count() % 2 == 1
+        let odd = self.pieces.iter().filter(|q| crosses_odd(q, p)).count() % 2 == 1;
+        odd != self.outer_is_domain
     }
 
     /// How the patch over `domain` (the surface's parameters) relates to the region.
@@ -121,6 +129,7 @@ impl TrimRegion {
             hi,
             near,
             far,
+            outer_is_domain: self.outer_is_domain,
         };
         if !trim.near.is_empty() {
             Coverage::Partial(Box::new(trim))
@@ -145,7 +154,7 @@ impl PatchTrim {
         for piece in &self.near {
             odd ^= crosses_odd(piece, p);
         }
-        odd
+        odd != self.outer_is_domain
     }
 
     /// Pieces this patch tests in full, and chords it tests by their end points.
@@ -157,32 +166,28 @@ impl PatchTrim {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::trim::pieces::tests::circle;
-    use crate::geom::trim::{ParamCurve, TrimSegment};
-    use glam::DVec3;
+    use crate::geom::trim::ParamCurve;
+
+    fn circle(c: DVec2, r: f64) -> ParamCurve {
+        ParamCurve::circle(c, r)
+    }
 
     fn whole(curve: ParamCurve, hole: bool) -> TrimLoop {
-        TrimLoop {
-            hole,
-            segments: vec![TrimSegment {
-                t0: 0.0,
-                t1: 1.0,
-                curve,
-            }],
-        }
+        TrimLoop::closed(curve, hole)
     }
 
     /// The boundary of `[a, b]²` as one degree-1 curve, counter-clockwise or clockwise.
     fn square(a: f64, b: f64, ccw: bool) -> ParamCurve {
-        let mut pts = vec![(a, a), (b, a), (b, b), (a, b), (a, a)];
+        let mut corners = vec![
+            DVec2::new(a, a),
+            DVec2::new(b, a),
+            DVec2::new(b, b),
+            DVec2::new(a, b),
+        ];
         if !ccw {
-            pts.reverse();
+            corners.reverse();
         }
-        ParamCurve {
-            degree: 1,
-            knots: vec![0.0, 0.0, 0.25, 0.5, 0.75, 1.0, 1.0],
-            points: pts.iter().map(|&(x, y)| DVec3::new(x, y, 1.0)).collect(),
-        }
+        ParamCurve::polygon(&corners)
     }
 
     fn identity() -> [AxisMap; 2] {
@@ -210,6 +215,21 @@ mod tests {
             }
         }
         assert!(!region.contains(1.5, 0.5) && !region.contains(-0.1, 0.5));
+    }
+
+    #[test]
+    fn holes_without_an_outer_loop_cut_the_whole_domain() {
+        let c = DVec2::new(0.3, 0.6);
+        let region = TrimRegion::new(&[whole(circle(c, 0.2), true)], &identity())
+            .unwrap()
+            .unwrap();
+        assert!(!region.contains(0.3, 0.6) && !region.contains(0.45, 0.6));
+        assert!(region.contains(0.9, 0.1) && region.contains(0.3, 0.85));
+        // As an outer loop the same circle keeps only its inside.
+        let outer = TrimRegion::new(&[whole(circle(c, 0.2), false)], &identity())
+            .unwrap()
+            .unwrap();
+        assert!(outer.contains(0.3, 0.6) && !outer.contains(0.9, 0.1));
     }
 
     #[test]
