@@ -333,40 +333,10 @@ pub(super) fn tessellate_trimmed(
 mod tests {
     use super::*;
     use crate::geom::nurbs::NurbsSurface;
-    use crate::geom::trim::pieces::tests::circle;
-    use crate::geom::trim::{ParamCurve, TrimLoop, TrimSegment};
+    use crate::geom::trim::{ParamCurve, TrimLoop};
     use crate::scene::model::{Geometry, Object, SurfaceGeometry};
     use crate::tessellate::{TessellationMode, tessellate_object};
     use std::f64::consts::PI;
-
-    fn closed(curve: ParamCurve, hole: bool) -> TrimLoop {
-        TrimLoop {
-            hole,
-            segments: vec![TrimSegment {
-                t0: 0.0,
-                t1: 1.0,
-                curve,
-            }],
-        }
-    }
-
-    /// A closed polygon as one degree-1 curve.
-    fn polygon(corners: &[(f64, f64)]) -> ParamCurve {
-        let mut points: Vec<DVec3> = corners
-            .iter()
-            .map(|&(x, y)| DVec3::new(x, y, 1.0))
-            .collect();
-        points.push(points[0]);
-        let n = points.len();
-        let mut knots = vec![0.0];
-        knots.extend((0..n).map(|k| k as f64 / (n - 1) as f64));
-        knots.push(1.0);
-        ParamCurve {
-            degree: 1,
-            knots,
-            points,
-        }
-    }
 
     /// The even-odd test against a polygon, independent of the trim code.
     fn in_polygon(p: DVec2, poly: &[DVec2]) -> bool {
@@ -410,19 +380,20 @@ mod tests {
         let knots = vec![0.0, 0.0, 0.0, 1.0, 2.0, 2.0, 2.0];
         let nurbs = NurbsSurface::new(2, 2, knots.clone(), knots, n, n, points).unwrap();
         let (c, r) = (DVec2::new(1.0, 0.9), 0.5);
-        let outer = [(0.1, 0.1), (1.9, 0.1), (1.9, 1.9), (0.1, 1.9)];
-        let island = [(0.9, 0.8), (0.9, 1.0), (1.1, 1.0), (1.1, 0.8)];
+        let to2 =
+            |q: &[(f64, f64)]| -> Vec<DVec2> { q.iter().map(|&(x, y)| DVec2::new(x, y)).collect() };
+        let outer = to2(&[(0.1, 0.1), (1.9, 0.1), (1.9, 1.9), (0.1, 1.9)]);
+        let island = to2(&[(0.9, 0.8), (0.9, 1.0), (1.1, 1.0), (1.1, 0.8)]);
         let surface = Surface {
             geometry: SurfaceGeometry::Nurbs(nurbs),
             trims: vec![
-                closed(polygon(&outer), false),
-                closed(circle(c, r), true),
-                closed(polygon(&island), false),
+                TrimLoop::closed(ParamCurve::polygon(&outer), false),
+                TrimLoop::closed(ParamCurve::circle(c, r), true),
+                TrimLoop::closed(ParamCurve::polygon(&island), false),
             ],
             trim_space: Default::default(),
         };
-        let to2 = |q: &[(f64, f64)]| q.iter().map(|&(x, y)| DVec2::new(x, y)).collect();
-        let loops = vec![to2(&outer), dense_circle(c, r), to2(&island)];
+        let loops = vec![outer, dense_circle(c, r), island];
         (surface, loops)
     }
 
@@ -492,11 +463,11 @@ mod tests {
         for tolerance in [1e-2, 1e-4] {
             let surface = Surface {
                 trims: vec![
-                    closed(
-                        polygon(&[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]),
+                    TrimLoop::closed(
+                        ParamCurve::polygon(&[DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y]),
                         false,
                     ),
-                    closed(circle(DVec2::new(0.45, 0.55), r), true),
+                    TrimLoop::closed(ParamCurve::circle(DVec2::new(0.45, 0.55), r), true),
                 ],
                 ..Surface::bezier(plate.clone())
             };
