@@ -27,7 +27,8 @@ pub enum Command {
     Render(RenderArgs),
     /// Nearest hit per ray from a ray file, as CSV.
     Trace(TraceArgs),
-    /// Tessellate free-form surfaces into a triangle mesh (OBJ, glTF or GLB).
+    /// Tessellate free-form surfaces into a triangle mesh (OBJ, glTF or GLB); trimmed ones
+    /// in their parameter domain, with the gaps between trimmed faces reported.
     Tessellate(TessellateArgs),
     /// Compare two images (PNG or EXR): RMSE, PSNR, MAE, max error, FLIP, coverage.
     Diff(DiffArgs),

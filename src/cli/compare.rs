@@ -37,6 +37,8 @@ struct Row {
     psnr: f64,
     flip_mean: f64,
     silhouette_pixels: u64,
+    /// The largest gap between trimmed faces (tessellations only).
+    trim_gap: Option<f64>,
 }
 
 /// Builds the accelerator and renders, timing both.
@@ -84,6 +86,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
         psnr: f64::INFINITY,
         flip_mean: 0.0,
         silhouette_pixels: 0,
+        trim_gap: None,
     }];
 
     for &n in &args.triangles {
@@ -106,6 +109,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
             psnr: d.psnr,
             flip_mean: d.flip.mean,
             silhouette_pixels: d.coverage_mismatch.unwrap_or(0),
+            trim_gap: (report.trim_gaps.faces > 0).then_some(report.trim_gaps.largest),
         });
     }
 
@@ -130,7 +134,7 @@ fn write_text(path: &Path, text: &str) -> anyhow::Result<()> {
     Ok(())
 }
 
-const COLUMNS: [&str; 9] = [
+const COLUMNS: [&str; 10] = [
     "method",
     "triangles",
     "memory (bytes)",
@@ -140,9 +144,10 @@ const COLUMNS: [&str; 9] = [
     "PSNR (dB)",
     "FLIP mean",
     "silhouette pixels",
+    "trim gap",
 ];
 
-fn cells(r: &Row) -> [String; 9] {
+fn cells(r: &Row) -> [String; 10] {
     [
         r.method.clone(),
         r.triangles.to_string(),
@@ -157,6 +162,7 @@ fn cells(r: &Row) -> [String; 9] {
         },
         format!("{:.5}", r.flip_mean),
         r.silhouette_pixels.to_string(),
+        r.trim_gap.map_or("-".into(), |g| format!("{g:.3e}")),
     ]
 }
 

@@ -77,6 +77,14 @@ pub fn run(args: TessellateArgs) -> anyhow::Result<ExitCode> {
             args.output.display()
         )?;
         writeln!(out, "time:      {:.3} s", r.seconds)?;
+        let g = &r.mesh.trim_gaps;
+        if g.faces > 0 {
+            writeln!(
+                out,
+                "trim gaps: largest {:.3e} between {} trimmed faces; {} of {} shared boundary samples open wider than f32 rounding; {} samples with no other face within {:.3e} (free edges)",
+                g.largest, g.faces, g.open_samples, g.shared_samples, g.free_samples, g.radius
+            )?;
+        }
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -36,6 +36,34 @@ impl AxisMap {
             }
         }
     }
+
+    /// The NURBS parameter at trim parameter `a`, the inverse of [`Self::apply`]: on the
+    /// arc whose angles bracket `a` (the nearest end arc outside them),
+    /// s = (tan(α/2) / tan(Δ/4) + 1) / 2. The tessellator needs it to place the samples of
+    /// a trim loop on the surface.
+    pub fn invert(&self, a: f64) -> f64 {
+        match self {
+            AxisMap::Identity => a,
+            AxisMap::Arcs { breaks, angles } => {
+                let n = angles.len() - 1;
+                // Angles run one way along the breaks; count the inner ones a has passed.
+                let rising = angles[n] >= angles[0];
+                let i = angles[1..n]
+                    .iter()
+                    .take_while(|&&x| if rising { x <= a } else { x >= a })
+                    .count();
+                let (b0, b1) = (breaks[i], breaks[i + 1]);
+                let (a0, a1) = (angles[i], angles[i + 1]);
+                let quarter = (0.25 * (a1 - a0)).tan();
+                let s = if quarter == 0.0 {
+                    0.5
+                } else {
+                    0.5 * ((0.5 * (a - 0.5 * (a0 + a1))).tan() / quarter + 1.0)
+                };
+                b0 + (b1 - b0) * s
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -63,6 +91,7 @@ mod tests {
             let h = p0 * (1.0 - s) * (1.0 - s) + p1 * 2.0 * s * (1.0 - s) + p2 * s * s;
             let angle = (h.y / h.z).atan2(h.x / h.z);
             assert!((map.apply(2.0 + s) - angle).abs() < 1e-14, "s = {s}");
+            assert!((map.invert(angle) - (2.0 + s)).abs() < 1e-14, "s = {s}");
         }
     }
 }

@@ -85,6 +85,17 @@ impl TrimRegion {
         self.pieces.len()
     }
 
+    /// The Bézier pieces of all loops in trim parameters; each loop's pieces follow one
+    /// another end to start (the tessellator samples them as constraint edges).
+    pub fn pieces(&self) -> &[Piece] {
+        &self.pieces
+    }
+
+    /// The maps from the surface's parameters to the trim parameters the pieces are in.
+    pub fn maps(&self) -> &[AxisMap; 2] {
+        &self.map
+    }
+
     /// Whether the surface exists at (u, v), in the surface's own parameters.
     pub fn contains(&self, u: f64, v: f64) -> bool {
         let p = DVec2::new(self.map[0].apply(u), self.map[1].apply(v));
