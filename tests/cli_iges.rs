@@ -28,7 +28,13 @@ fn hammer_renders_the_same_from_iges_as_from_obj() {
     let o = run(&["diff", a.to_str().unwrap(), b.to_str().unwrap(), "--json"]);
     let report: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
     assert_eq!(report["above_count"], 0, "{report}");
-    assert_eq!(report["coverage_mismatch"], 0, "{report}");
+    // The OBJ conversion writes numbers to 10 significant digits and gives a 128's
+    // parameter range as a `surf` range (the surface restricted) where the IGES reader
+    // makes it an outer trim loop: a silhouette pixel may flip between hit and miss.
+    assert!(
+        report["coverage_mismatch"].as_u64().unwrap() <= 2,
+        "{report}"
+    );
 }
 
 #[test]

@@ -12,6 +12,7 @@ use glam::{DVec3, Vec3};
 
 use super::bvh::{Bvh, GeometryHasher};
 use super::grid::Grid;
+use crate::geom::trim::PatchTrim;
 use crate::geom::{Aabb, BezierPatch, DAabb, Ray};
 use crate::kernel::cached::{self, CachedConfig};
 use crate::kernel::subdivision::{self, PreparedPatch, SubdivisionConfig};
@@ -231,6 +232,8 @@ pub struct SceneGeometry {
     originals: Vec<BezierPatch>,
     /// (object, patch within object) per patch.
     ids: Vec<(u32, u32)>,
+    /// Per patch, its trim where its loops cut it.
+    trims: Vec<Option<Box<PatchTrim>>>,
     triangles: Triangles,
     accel: Accel,
 }
@@ -238,11 +241,13 @@ pub struct SceneGeometry {
 impl SceneGeometry {
     /// Prepares the patches and builds the BVH.
     pub fn build(scene: &Scene) -> SceneGeometry {
-        let (originals, ids) = collect_patches(scene);
+        let patches = collect_patches(scene);
         let triangles = collect_triangles(scene);
-        let boxes: Vec<Aabb> = originals
+        let boxes: Vec<Aabb> = patches
+            .originals
             .iter()
-            .map(|p| p.tight_box().to_f32_outward())
+            .zip(&patches.trims)
+            .map(|(p, trim)| surviving_box(p, trim.as_deref()).to_f32_outward())
             .chain(
                 triangles
                     .corners
@@ -250,33 +255,27 @@ impl SceneGeometry {
                     .map(|c| c.iter().copied().collect()),
             )
             .collect();
-        let bvh = Bvh::build_packed(&boxes, originals.len());
-        {
-            let accel = Accel::bvh(bvh, originals.len(), &triangles);
-            Self::with_accel(originals, ids, triangles, accel)
-        }
+        let bvh = Bvh::build_packed(&boxes, patches.originals.len());
+        let accel = Accel::bvh(bvh, patches.originals.len(), &triangles);
+        Self::with_accel(patches, triangles, accel)
     }
 
     /// Prepares the patches and builds the uniform grid of LG90 §3.1 within `budget_bytes`
     /// (see [`Grid::build`]).
     pub fn build_grid(scene: &Scene, budget_bytes: usize) -> SceneGeometry {
-        let (originals, ids) = collect_patches(scene);
+        let patches = collect_patches(scene);
         let triangles = collect_triangles(scene);
-        let grid = Grid::build(&originals, &triangles.corners, budget_bytes);
-        Self::with_accel(originals, ids, triangles, Accel::Grid(grid))
+        let grid = Grid::build(&patches.originals, &triangles.corners, budget_bytes);
+        Self::with_accel(patches, triangles, Accel::Grid(grid))
     }
 
-    fn with_accel(
-        originals: Vec<BezierPatch>,
-        ids: Vec<(u32, u32)>,
-        triangles: Triangles,
-        accel: Accel,
-    ) -> SceneGeometry {
-        let prepared = originals.iter().map(PreparedPatch::new).collect();
+    fn with_accel(patches: Patches, triangles: Triangles, accel: Accel) -> SceneGeometry {
+        let prepared = patches.originals.iter().map(PreparedPatch::new).collect();
         SceneGeometry {
             prepared,
-            originals,
-            ids,
+            originals: patches.originals,
+            ids: patches.ids,
+            trims: patches.trims,
             triangles,
             accel,
         }
@@ -394,7 +393,9 @@ impl SceneGeometry {
                 continue;
             }
             stats.kernel.patch_tests += 1;
-            if let Some(h) = subdivision::intersect_f64(patch, origin, dir, tmin, limit, cfg) {
+            let trim = self.trims[prim].as_deref();
+            if let Some(h) = subdivision::intersect_f64(patch, origin, dir, tmin, limit, cfg, trim)
+            {
                 best = Some((prim as u32, h));
             }
         }
@@ -592,20 +593,19 @@ impl SceneGeometry {
     ) -> Option<(f32, Candidate)> {
         let patch_hit = |h: PatchHit| (h.t, Candidate::Patch(prim, h));
         let r = Ray { tmax, ..*ray.ray };
+        let (patch, trim) = (&self.originals[prim as usize], self.trim(prim));
         match precision {
             Precision::Toth(cfg) => {
                 let origin = cfg.surface_of_origin == Some(prim);
-                toth::intersect(&self.originals[prim as usize], &r, cfg, origin, kernel)
-                    .map(patch_hit)
+                toth::intersect(patch, trim, &r, cfg, origin, kernel).map(patch_hit)
             }
             Precision::Cached(cfg) => {
                 let origin = cfg.toth.surface_of_origin == Some(prim);
-                cached::intersect(&self.originals[prim as usize], &r, cfg, origin, kernel)
-                    .map(patch_hit)
+                cached::intersect(patch, trim, &r, cfg, origin, kernel).map(patch_hit)
             }
             Precision::F32(cfg) | Precision::F64(cfg) => {
-                let patch = &self.prepared[prim as usize];
-                subdivision::nearest(patch, ray.kernel(cfg), tmax, cfg, kernel)
+                let prepared = &self.prepared[prim as usize];
+                subdivision::nearest(prepared, trim, ray.kernel(cfg), tmax, cfg, kernel)
                     .map(|h| (h.t(), Candidate::Subdivision(prim, h)))
             }
         }
@@ -619,19 +619,27 @@ impl SceneGeometry {
         precision: &Precision,
         kernel: &mut KernelStats,
     ) -> bool {
+        let (patch, trim) = (&self.originals[prim as usize], self.trim(prim));
         match precision {
             Precision::Toth(cfg) => {
                 let origin = cfg.surface_of_origin == Some(prim);
-                toth::occluded(&self.originals[prim as usize], ray.ray, cfg, origin, kernel)
+                toth::occluded(patch, trim, ray.ray, cfg, origin, kernel)
             }
             Precision::Cached(cfg) => {
                 let origin = cfg.toth.surface_of_origin == Some(prim);
-                cached::occluded(&self.originals[prim as usize], ray.ray, cfg, origin, kernel)
+                cached::occluded(patch, trim, ray.ray, cfg, origin, kernel)
             }
             Precision::F32(cfg) | Precision::F64(cfg) => {
-                subdivision::blocks(&self.prepared[prim as usize], ray.kernel(cfg), cfg, kernel)
+                let prepared = &self.prepared[prim as usize];
+                subdivision::blocks(prepared, trim, ray.kernel(cfg), cfg, kernel)
             }
         }
+    }
+
+    /// Patch `prim`'s trim, `None` where its loops do not cut it.
+    #[inline]
+    fn trim(&self, prim: u32) -> Option<&PatchTrim> {
+        self.trims[prim as usize].as_deref()
     }
 
     fn finish_patch_hit(&self, prim: u32, t: f64, u: f64, v: f64, hit_box: Aabb) -> SceneHit {
@@ -685,23 +693,38 @@ impl SceneGeometry {
     }
 }
 
-/// All Bézier patches of the scene in contract order, with their (object, patch) ids.
-/// Patches collapsed to a curve or a point are left out: they have no area, so no ray hits
-/// them exactly, while rounding would let the `f32` kernel report hits on them whose
-/// secondary rays, lacking a normal to leave along, re-hit the same curve (issue 7).
-fn collect_patches(scene: &Scene) -> (Vec<BezierPatch>, Vec<(u32, u32)>) {
-    let mut patches = Vec::new();
-    let mut ids = Vec::new();
+/// The scene's patches as the accelerator indexes them.
+struct Patches {
+    originals: Vec<BezierPatch>,
+    /// (object, patch within object) per patch.
+    ids: Vec<(u32, u32)>,
+    /// Per patch, its trim where its loops cut it (Dammertz §2.6).
+    trims: Vec<Option<Box<PatchTrim>>>,
+}
+
+/// All Bézier patches of the scene in contract order, with their (object, patch) ids and
+/// trims. Patches collapsed to a curve or a point are left out: they have no area, so no
+/// ray hits them exactly, while rounding would let the `f32` kernel report hits on them
+/// whose secondary rays, lacking a normal to leave along, re-hit the same curve (issue 7).
+/// So are patches their trim loops cut away wholly (culling, issue 15).
+fn collect_patches(scene: &Scene) -> Patches {
+    let mut out = Patches {
+        originals: Vec::new(),
+        ids: Vec::new(),
+        trims: Vec::new(),
+    };
     for (o, object) in scene.objects.iter().enumerate() {
-        for (k, p) in object.bezier_patches().into_iter().enumerate() {
+        for (k, entry) in object.trimmed_patches().into_iter().enumerate() {
+            let Some((p, trim)) = entry else { continue };
             if p.has_zero_area() {
                 continue;
             }
-            patches.push(p);
-            ids.push((o as u32, k as u32));
+            out.originals.push(p);
+            out.ids.push((o as u32, k as u32));
+            out.trims.push(trim);
         }
     }
-    (patches, ids)
+    out
 }
 
 impl SceneGeometry {
@@ -714,20 +737,18 @@ impl SceneGeometry {
         use crate::scene::LoadError;
         let file = std::fs::File::open(path).map_err(|e| LoadError::io(path, e))?;
         let mut reader = std::io::BufReader::new(file);
-        let (originals, ids) = collect_patches(scene);
+        let patches = collect_patches(scene);
         let triangles = collect_triangles(scene);
-        let bvh = Bvh::read(&mut reader, hash_geometry(&originals, &triangles))
+        let bvh = Bvh::read(&mut reader, hash_geometry(&patches.originals, &triangles))
             .map_err(|e| LoadError::invalid(path, e.to_string()))?;
-        if bvh.prim_count() != originals.len() + triangles.corners.len() {
+        if bvh.prim_count() != patches.originals.len() + triangles.corners.len() {
             return Err(LoadError::invalid(
                 path,
                 "the BVH indexes a different number of patches than the scene; rebuild it with `patchtrace bvh`",
             ));
         }
-        Ok({
-            let accel = Accel::bvh(bvh, originals.len(), &triangles);
-            Self::with_accel(originals, ids, triangles, accel)
-        })
+        let accel = Accel::bvh(bvh, patches.originals.len(), &triangles);
+        Ok(Self::with_accel(patches, triangles, accel))
     }
 
     /// Writes the BVH with the scene's geometry hash, atomically; refused for a grid.
@@ -764,6 +785,37 @@ fn hash_geometry(patches: &[BezierPatch], triangles: &Triangles) -> u64 {
         }
     }
     h.finish()
+}
+
+/// Quarterings of a trimmed patch when bounding the part its loops keep: 4 × 4 pieces.
+const SURVIVING_BOX_LEVELS: u32 = 2;
+
+/// The BVH box of a patch: its tight box, or for a patch its trim loops cut, the union of
+/// the tight boxes of those of its 4 × 4 sub-patches (de Casteljau halvings) that keep any
+/// of the surface ([`PatchTrim::keeps_any_of`]). A plate mostly cut away then no longer
+/// sends every ray through its whole rectangle to the kernel; 16 sub-patches per cut patch
+/// at load is cheap. The kernel still starts from the whole patch.
+fn surviving_box(p: &BezierPatch, trim: Option<&PatchTrim>) -> DAabb {
+    let Some(trim) = trim else {
+        return p.tight_box();
+    };
+    let mut parts = vec![p.clone()];
+    for _ in 0..SURVIVING_BOX_LEVELS {
+        parts = parts
+            .iter()
+            .flat_map(|q| {
+                let (a, b) = q.split_u();
+                let (a0, a1) = a.split_v();
+                let (b0, b1) = b.split_v();
+                [a0, a1, b0, b1]
+            })
+            .collect();
+    }
+    let kept = parts
+        .iter()
+        .filter(|q| trim.keeps_any_of(q.domain()))
+        .fold(DAabb::EMPTY, |acc, q| acc.union(&q.tight_box()));
+    if kept.is_empty() { p.tight_box() } else { kept }
 }
 
 /// All mesh triangles of the scene in object order, rounded to `f32`.

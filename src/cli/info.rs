@@ -37,6 +37,20 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
             "  {}: material \"{}\", {} surface(s), {} NURBS, {} patch(es), {} trim loop(s), {} triangle(s)",
             o.name, o.material, o.surfaces, o.nurbs_surfaces, o.patches, o.trim_loops, o.triangles
         )?;
+        for t in &o.trimmed_surfaces {
+            writeln!(
+                out,
+                "    surface {}: {} trim loop(s) ({} hole(s)), {} curve(s) as {} Bézier piece(s); patches: {} cut, {} whole, {} cut away",
+                t.surface,
+                t.loops,
+                t.holes,
+                t.curves,
+                t.pieces,
+                t.patches_cut,
+                t.patches_whole,
+                t.patches_culled
+            )?;
+        }
         if let Some(sd) = &o.subdivision {
             writeln!(
                 out,

@@ -113,7 +113,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     let scene = &mut prepared.scene;
     args.size.apply(&mut scene.camera)?;
     let precision = precision(&args.kernel, &scene.camera)?;
-    let plan = EffectPlan::for_scene(scene);
+    let plan = EffectPlan {
+        trims: prepared.trims,
+        ..EffectPlan::for_scene(scene)
+    };
     eprintln!("{plan}");
     let integrator = Integrator {
         scene,
@@ -138,6 +141,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         (None, Some(tile)) => Window::tile(tile, width, height).map_err(anyhow::Error::msg)?,
         (None, None) => Window::full(width, height),
     };
+    crate::scene::check_film_pixels(window.width(), window.height())
+        .map_err(crate::cli::BadArgument)?;
     let job = RenderJob {
         order: args.order,
         samples,

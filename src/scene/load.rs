@@ -5,7 +5,7 @@ use std::path::Path;
 use super::error::LoadError;
 use super::model::Material;
 use super::model::{Geometry, Object, Scene, Surface};
-use super::{bpt, cage, iges, mesh, obj, pbrt, ron_format, step};
+use super::{bpt, cage, gltf_mesh, iges, mesh, obj, pbrt, ron_format, step};
 
 /// The kinds of input file we read, by extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -63,7 +63,7 @@ pub fn load_geometry(path: &Path) -> Result<Geometry, LoadError> {
             let src = super::error::read_text(path)?;
             Ok(Geometry::Surfaces(pbrt::parse_pbrt(path, &src)?))
         }
-        InputKind::Gltf => Ok(Geometry::Mesh(mesh::read_gltf(path)?)),
+        InputKind::Gltf => Ok(Geometry::Mesh(gltf_mesh::read_gltf(path)?)),
         InputKind::Iges => Ok(Geometry::Surfaces(
             read_iges_warning(path)?
                 .surfaces
@@ -99,7 +99,7 @@ pub fn load_subdivision(path: &Path) -> Result<Geometry, LoadError> {
         }
         InputKind::Gltf => Ok(Geometry::Subdivision(cage::mesh_cage(
             path,
-            &mesh::read_gltf(path)?,
+            &gltf_mesh::read_gltf(path)?,
         )?)),
         InputKind::Bpt => Err(refuse("a .bpt file of Bézier patches")),
         InputKind::Pbrt => Err(refuse("a pbrt file")),
@@ -153,7 +153,28 @@ pub fn load_scene_noted(
         (read_any_scene(path)?, Vec::new())
     };
     check_f32_range(path, &scene)?;
+    check_trims(path, &scene)?;
     Ok((scene, notes))
+}
+
+/// Every trim loop converts to Bézier pieces (degrees, knots, weights, ranges), checked
+/// once at load so that the renderer never meets loops it cannot apply; the error names
+/// the object and surface.
+pub fn check_trims(path: &Path, scene: &Scene) -> Result<(), LoadError> {
+    for o in &scene.objects {
+        let Geometry::Surfaces(surfaces) = &o.geometry else {
+            continue;
+        };
+        for (k, s) in surfaces.iter().enumerate() {
+            if let Err(e) = s.trim_region() {
+                return Err(LoadError::invalid(
+                    path,
+                    format!("object \"{}\", surface {k}: trim loops: {e}", o.name),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Smallest object extent the renderer accepts: 2^-60 ≈ 8.7e-19. Shading squares
@@ -182,16 +203,31 @@ pub fn check_f32_range(path: &Path, scene: &Scene) -> Result<(), LoadError> {
             ));
         }
         let largest = b.min.abs().max(b.max.abs()).max_element();
-        if !((largest as f32).is_finite()) {
+        // Box arithmetic (slab tests, extents, the default camera's distance) works on
+        // differences of coordinates, so the extent must fit as well: a patch at ±3e38
+        // has finite corners but an infinite f32 width.
+        if !((largest as f32).is_finite()) || !((extent as f32).is_finite()) {
             return Err(LoadError::invalid(
                 path,
                 format!(
-                    "object \"{}\": coordinates reach {largest:e} after transforms, beyond the f32 range (±{:e}) the renderer works in",
+                    "object \"{}\": coordinates reach {largest:e} and the box spans {extent:e} after transforms, beyond the f32 range (±{:e}) the renderer works in; scale the scene down",
                     o.name,
                     f32::MAX
                 ),
             ));
         }
+    }
+    let c = &scene.camera;
+    if !(c.eye.as_vec3().is_finite() && c.look_at.as_vec3().is_finite()) {
+        return Err(LoadError::invalid(
+            path,
+            format!(
+                "camera: eye {} or look_at {} is beyond the f32 range (±{:e}) the renderer works in",
+                c.eye,
+                c.look_at,
+                f32::MAX
+            ),
+        ));
     }
     Ok(())
 }

@@ -553,6 +553,7 @@ fn search_avx512(
         frame,
         cfg,
         any_hit,
+        trim,
     }: Query,
     stats: &mut KernelStats,
 ) -> Option<SpacedHit> {
@@ -575,7 +576,7 @@ fn search_avx512(
             let floor = frame.world_length(end_game_diameter(&root, cfg.end_ulps));
             let mut nets = RegisterStack::with_registers(local, registers, floor, slots);
             let hit = search(
-                &mut nets, nodes, local_root, &axis, false, cfg, any_hit, stats,
+                &mut nets, nodes, local_root, &axis, false, cfg, any_hit, trim, stats,
             )?;
             return Some(SpacedHit {
                 hit,
@@ -584,7 +585,10 @@ fn search_avx512(
         }
     }
     let mut nets = RegisterStack::new(world, ray, slots);
-    search(&mut nets, nodes, root, ray, false, cfg, any_hit, stats).map(SpacedHit::world)
+    search(
+        &mut nets, nodes, root, ray, false, cfg, any_hit, trim, stats,
+    )
+    .map(SpacedHit::world)
 }
 
 #[cfg(test)]
@@ -651,6 +655,7 @@ mod tests {
                     frame: None,
                     cfg: &cfg,
                     any_hit,
+                    trim: None,
                 };
                 let a = search_net16(&net, &mut scratch16, q, &mut s16);
                 assert!(a.is_none_or(|h| h.ray_space_scale.is_none()));
@@ -684,6 +689,7 @@ mod tests {
                 frame,
                 cfg: &cfg,
                 any_hit: false,
+                trim: None,
             };
             let h = search_net16(&net, &mut scratch, q, &mut stats)?;
             Some(match (h.ray_space_scale, frame) {

@@ -53,6 +53,7 @@ use ray_space::{RayFrame, SpacedHit};
 use register::{Query, search_register};
 use search::search;
 
+use crate::geom::trim::PatchTrim;
 use crate::geom::ulp::ulp_of;
 use crate::geom::{Aabb, Ray};
 use crate::kernel::{KernelStats, PatchHit};
@@ -150,23 +151,25 @@ impl KernelHit {
 /// Nearest hit with `t` in `[ray.tmin, ray.tmax]`; `ray.tmax` is the current closest hit.
 pub fn intersect(
     patch: &PreparedPatch,
+    trim: Option<&PatchTrim>,
     ray: &Ray,
     cfg: &SubdivisionConfig,
     stats: &mut KernelStats,
 ) -> Option<PatchHit> {
     let ray = KernelRay::new(ray, cfg);
-    nearest(patch, &ray, ray.ray.tmax, cfg, stats).map(|h| ray.patch_hit(&h))
+    nearest(patch, trim, &ray, ray.ray.tmax, cfg, stats).map(|h| ray.patch_hit(&h))
 }
 
 /// [`intersect`] for a ray made once for every patch it meets, with `t` up to `tmax`.
 pub fn nearest(
     patch: &PreparedPatch,
+    trim: Option<&PatchTrim>,
     ray: &KernelRay,
     tmax: f32,
     cfg: &SubdivisionConfig,
     stats: &mut KernelStats,
 ) -> Option<KernelHit> {
-    run(patch, ray, tmax, cfg, false, stats).map(KernelHit)
+    run(patch, trim, ray, tmax, cfg, false, stats).map(KernelHit)
 }
 
 /// `hit_box` grown on every side by [`NET_ROUNDING_ULPS`] ulps of the largest coordinate
@@ -181,25 +184,28 @@ pub fn widen_by_net_rounding(hit_box: Aabb, root: &Aabb) -> Aabb {
 /// Any hit in `[ray.tmin, ray.tmax]` (shadow rays): stops at the first final box found.
 pub fn occluded(
     patch: &PreparedPatch,
+    trim: Option<&PatchTrim>,
     ray: &Ray,
     cfg: &SubdivisionConfig,
     stats: &mut KernelStats,
 ) -> bool {
-    blocks(patch, &KernelRay::new(ray, cfg), cfg, stats)
+    blocks(patch, trim, &KernelRay::new(ray, cfg), cfg, stats)
 }
 
 /// [`occluded`] for a ray made once for every patch it meets.
 pub fn blocks(
     patch: &PreparedPatch,
+    trim: Option<&PatchTrim>,
     ray: &KernelRay,
     cfg: &SubdivisionConfig,
     stats: &mut KernelStats,
 ) -> bool {
-    run(patch, ray, ray.ray.tmax, cfg, true, stats).is_some()
+    run(patch, trim, ray, ray.ray.tmax, cfg, true, stats).is_some()
 }
 
 fn run(
     patch: &PreparedPatch,
+    trim: Option<&PatchTrim>,
     ray: &KernelRay,
     tmax: f32,
     cfg: &SubdivisionConfig,
@@ -214,6 +220,7 @@ fn run(
         frame: ray.frame.as_ref(),
         cfg,
         any_hit,
+        trim,
     };
     match &patch.data {
         #[cfg(target_arch = "x86_64")]
@@ -236,6 +243,7 @@ fn run(
                 shape.rational,
                 cfg,
                 any_hit,
+                trim,
                 stats,
             )
             .map(SpacedHit::world)

@@ -22,6 +22,7 @@ use super::param::{ParamCell, Split};
 use super::ray_space::RayFrame;
 use super::search::{NetStack, Node, SearchHit, search};
 use crate::geom::bbox::slab;
+use crate::geom::trim::PatchTrim;
 use crate::kernel::KernelStats;
 
 /// The boxes of a split's two children (lower first), each with the entry `t` of its slab
@@ -232,6 +233,8 @@ pub struct Query<'a> {
     pub frame: Option<&'a RayFrame>,
     pub cfg: &'a SubdivisionConfig,
     pub any_hit: bool,
+    /// The patch's trim loops, if it has any ([`super::search::search`]).
+    pub trim: Option<&'a PatchTrim>,
 }
 
 /// The reusable buffers of a register-net search: the pushed nets and the search nodes.
@@ -270,7 +273,7 @@ fn search_portable<N: RegisterNet>(
 ) -> Option<SearchHit<f32>> {
     let mut nets = RegisterStack::new(net, q.ray, slots);
     search(
-        &mut nets, nodes, q.root, q.ray, false, q.cfg, q.any_hit, stats,
+        &mut nets, nodes, q.root, q.ray, false, q.cfg, q.any_hit, q.trim, stats,
     )
 }
 
