@@ -56,22 +56,11 @@ impl ParamCurve {
     /// `[0, 1]`: the 9-point rational quadratic of Piegl & Tiller §7.5 (four quadrants,
     /// corner weights √2/2), exact.
     pub fn circle(c: DVec2, r: f64) -> ParamCurve {
-        let w = std::f64::consts::FRAC_1_SQRT_2;
-        let unit = [
-            (1., 0., 1.),
-            (1., 1., w),
-            (0., 1., 1.),
-            (-1., 1., w),
-            (-1., 0., 1.),
-            (-1., -1., w),
-            (0., -1., 1.),
-            (1., -1., w),
-            (1., 0., 1.),
-        ];
+        use crate::geom::nurbs::shapes;
         ParamCurve {
             degree: 2,
-            knots: vec![0., 0., 0., 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1., 1., 1.],
-            points: unit
+            knots: shapes::CIRCLE_KNOTS.to_vec(),
+            points: shapes::circle()
                 .iter()
                 .map(|&(x, y, w)| DVec3::new((c.x + r * x) * w, (c.y + r * y) * w, w))
                 .collect(),
