@@ -33,47 +33,42 @@ pub fn crosses_odd(piece: &Piece, p: DVec2) -> bool {
 }
 
 /// The parity for a piece whose box straddles `p`'s vertical: halve it, decide each half
-/// by its box, and go on with the halves that still straddle.
+/// by its box, and go on with the halves that still straddle. Recursive, so that a query
+/// touches only as many levels of halves as it descends (a stack sized for the deepest
+/// case cost more to clear than most queries spend).
 fn subdivide(points: &[DVec3], size: DVec2, p: DVec2) -> bool {
+    descend(points, size, p, 0)
+}
+
+fn descend(points: &[DVec3], parent: DVec2, p: DVec2, level: usize) -> bool {
     let n = points.len();
-    // A stack of pending halves, each with the box size of its parent.
-    let mut stack = [([DVec3::ZERO; MAX_DEGREE + 1], DVec2::ZERO, 0usize); MAX_LEVELS + 1];
-    stack[0].0[..n].copy_from_slice(points);
-    stack[0].1 = size;
-    let mut top = 1;
-    let mut odd = false;
+    let mut lower = [DVec3::ZERO; MAX_DEGREE + 1];
     let mut upper = [DVec3::ZERO; MAX_DEGREE + 1];
-    while top > 0 {
-        top -= 1;
-        let (mut cur, parent, level) = stack[top];
-        halve(&mut cur[..n], &mut upper[..n]);
-        for half in [&cur[..n], &upper[..n]] {
-            let (lo, hi) = hull(half);
-            if hi.y <= p.y || lo.y > p.y || hi.x <= p.x {
-                continue;
-            }
-            let (a, b) = (project(half[0]), project(half[n - 1]));
-            let ends = (a.y > p.y) != (b.y > p.y);
-            if lo.x > p.x {
-                odd ^= ends;
-                continue;
-            }
-            let extent = hi - lo;
-            let shrinking = extent.x + extent.y < parent.x + parent.y;
-            if !shrinking || level + 1 >= MAX_LEVELS {
-                // Within rounding of the curve: the chord decides.
-                if ends {
-                    let u = a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y);
-                    odd ^= u > p.x;
-                }
-                continue;
-            }
-            let slot = &mut stack[top];
-            slot.0[..n].copy_from_slice(half);
-            slot.1 = extent;
-            slot.2 = level + 1;
-            top += 1;
+    lower[..n].copy_from_slice(points);
+    halve(&mut lower[..n], &mut upper[..n]);
+    let mut odd = false;
+    for half in [&lower[..n], &upper[..n]] {
+        let (lo, hi) = hull(half);
+        if hi.y <= p.y || lo.y > p.y || hi.x <= p.x {
+            continue;
         }
+        let (a, b) = (project(half[0]), project(half[n - 1]));
+        let ends = (a.y > p.y) != (b.y > p.y);
+        if lo.x > p.x {
+            odd ^= ends;
+            continue;
+        }
+        let extent = hi - lo;
+        let shrinking = extent.x + extent.y < parent.x + parent.y;
+        if !shrinking || level + 1 >= MAX_LEVELS {
+            // Within rounding of the curve: the chord decides.
+            if ends {
+                let u = a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y);
+                odd ^= u > p.x;
+            }
+            continue;
+        }
+        odd ^= descend(half, extent, p, level + 1);
     }
     odd
 }
