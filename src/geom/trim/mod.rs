@@ -91,6 +91,26 @@ impl ParamCurve {
     }
 }
 
+impl TrimSegment {
+    /// The polyline through `points` as a degree-1 segment, parameter k at point k, over
+    /// `[0, n − 1]` (CAD readers' projected trim curves and domain rectangles).
+    pub fn polyline(points: &[DVec2]) -> TrimSegment {
+        let n = points.len();
+        let mut knots = vec![0.0];
+        knots.extend((0..n).map(|k| k as f64));
+        knots.push((n - 1) as f64);
+        TrimSegment {
+            t0: 0.0,
+            t1: (n - 1) as f64,
+            curve: ParamCurve {
+                degree: 1,
+                knots,
+                points: points.iter().map(|p| p.extend(1.0)).collect(),
+            },
+        }
+    }
+}
+
 impl TrimLoop {
     /// A loop of one closed curve, taken over its whole domain.
     pub fn closed(curve: ParamCurve, hole: bool) -> TrimLoop {

@@ -6,7 +6,7 @@
 //! laid in a frame of the plane around the boundary curves, projected onto it exactly
 //! (an affine map of the control points).
 
-use glam::{DVec3, DVec4};
+use glam::{DVec2, DVec3, DVec4};
 
 use super::curves::{self, Piece};
 use super::entities::Entity;
@@ -94,29 +94,9 @@ fn rectangle(u0: f64, u1: f64, v0: f64, v1: f64) -> TrimLoop {
     let corners = [(u0, v0), (u1, v0), (u1, v1), (u0, v1), (u0, v0)];
     TrimLoop {
         hole: false,
-        segments: vec![polyline(
-            corners
-                .iter()
-                .map(|&(u, v)| DVec3::new(u, v, 1.0))
-                .collect(),
+        segments: vec![TrimSegment::polyline(
+            &corners.map(|(u, v)| DVec2::new(u, v)),
         )],
-    }
-}
-
-/// A degree-1 loop segment through homogeneous (u, v, 1) points, parameter i at point i.
-fn polyline(points: Vec<DVec3>) -> TrimSegment {
-    let n = points.len();
-    let mut knots = vec![0.0];
-    knots.extend((0..n).map(|i| i as f64));
-    knots.push((n - 1) as f64);
-    TrimSegment {
-        t0: 0.0,
-        t1: (n - 1) as f64,
-        curve: ParamCurve {
-            degree: 1,
-            knots,
-            points,
-        },
     }
 }
 
@@ -197,15 +177,11 @@ fn boundary(
                     .project(q)
                     .ok_or("a model-space trim point could not be projected")?;
                 report.max_projection_error = report.max_projection_error.max(hit.distance);
-                points.push(DVec3::new(
-                    c.maps[0].apply(hit.u),
-                    c.maps[1].apply(hit.v),
-                    1.0,
-                ));
+                points.push(DVec2::new(c.maps[0].apply(hit.u), c.maps[1].apply(hit.v)));
             }
         }
         if points.len() >= 2 {
-            segments.push(polyline(points));
+            segments.push(TrimSegment::polyline(&points));
         }
     }
     report.projected += 1;

@@ -83,23 +83,6 @@ fn as_param(c: &NurbsCurve) -> ParamCurve {
     }
 }
 
-/// The polyline through `points` as a degree-1 segment over `[0, n − 1]`.
-fn polyline(points: &[DVec2]) -> TrimSegment {
-    let n = points.len();
-    let mut knots = vec![0.0];
-    knots.extend((0..n).map(|k| k as f64));
-    knots.push((n - 1) as f64);
-    TrimSegment {
-        t0: 0.0,
-        t1: (n - 1) as f64,
-        curve: ParamCurve {
-            degree: 1,
-            knots,
-            points: points.iter().map(|p| p.extend(1.0)).collect(),
-        },
-    }
-}
-
 impl Piece {
     fn new(seg: TrimSegment, reversed: bool) -> Piece {
         let c = as_nurbs(&seg.curve);
@@ -357,7 +340,7 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
                         .map_err(|m| format!("edge #{}: {m}", e.id))?;
                     projection_error = projection_error.max(err);
                     projected_edges += 1;
-                    list.push(polyline(&points));
+                    list.push(TrimSegment::polyline(&points));
                 }
                 slot.insert(list);
             }
@@ -397,7 +380,10 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
             if let Some(end) = prev_end
                 && piece.start().distance(end) > 1e-9 * (1.0 + end.length())
             {
-                pieces.push(Piece::new(polyline(&[end, piece.start()]), false));
+                pieces.push(Piece::new(
+                    TrimSegment::polyline(&[end, piece.start()]),
+                    false,
+                ));
             }
             pieces.push(piece);
         }
@@ -418,7 +404,7 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
             })
         });
         if winds.is_none() && gap.length() > 1e-9 * (1.0 + last.length()) {
-            pieces.push(Piece::new(polyline(&[last, first]), false));
+            pieces.push(Piece::new(TrimSegment::polyline(&[last, first]), false));
         }
         let mut lo = f64::INFINITY;
         let mut hi = f64::NEG_INFINITY;
@@ -475,7 +461,10 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
             a[other] = far;
             let mut b = first;
             b[other] = far;
-            pieces.push(Piece::new(polyline(&[last, a, b, first]), false));
+            pieces.push(Piece::new(
+                TrimSegment::polyline(&[last, a, b, first]),
+                false,
+            ));
         }
         trims.push(TrimLoop {
             hole: k > 0,
