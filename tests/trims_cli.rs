@@ -8,27 +8,13 @@
 
 mod common;
 
-use common::{run, stderr, stdout, testdata};
+use common::testdata;
 
 /// `object` of every row of `trace` for `rays`.
 fn objects(rays: &str, extra: &[&str]) -> Vec<String> {
-    let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("rays.txt");
-    std::fs::write(&file, rays).unwrap();
-    let scene = testdata("holed_plate.ron");
-    let mut args = vec![
-        "trace",
-        scene.to_str().unwrap(),
-        "--rays",
-        file.to_str().unwrap(),
-    ];
-    args.extend_from_slice(extra);
-    let o = run(&args);
-    assert!(o.status.success(), "{}", stderr(&o));
-    stdout(&o)
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').nth(3).unwrap_or_default().to_string())
+    common::trace_rows(&testdata("holed_plate.ron"), rays, extra)
+        .into_iter()
+        .map(|row| row[3].clone())
         .collect()
 }
 

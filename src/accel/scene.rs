@@ -393,7 +393,7 @@ impl SceneGeometry {
                 continue;
             }
             stats.kernel.patch_tests += 1;
-            let trim = self.trims[prim].as_deref();
+            let trim = self.trim(prim as u32);
             if let Some(h) = subdivision::intersect_f64(patch, origin, dir, tmin, limit, cfg, trim)
             {
                 best = Some((prim as u32, h));
