@@ -146,6 +146,54 @@ fn rays_at_the_middle_of_every_face_hit_that_face() {
     }
 }
 
+/// Rays through the hole (the top plane's and the bottom B-spline's inner loops, the wall's
+/// and fillet's seams) must pass: vertical rays on a polar grid inside the wall's radius,
+/// seam angle included, both ways, and slanted rays through the hole's centre that stay
+/// inside the wall and under the fillet (offset at most 0.8 · 0.5 = 0.4 < HOLE at z = 0
+/// and z = 1). Rays just outside the fillet's outer circle must still hit the top plane.
+#[test]
+fn rays_through_the_hole_pass_and_just_outside_it_hit_the_top() {
+    let dir = tempfile::tempdir().unwrap();
+    let part = write_part(dir.path());
+    let (a, f) = (HOLE, FILLET);
+    let mut through = Vec::new();
+    for i in 0..12 {
+        let r = a * (0.02 + 0.96 * i as f64 / 11.0);
+        for j in 0..16 {
+            let t = std::f64::consts::TAU * j as f64 / 16.0;
+            let (x, y) = (r * t.cos(), r * t.sin());
+            through.push((DVec3::new(x, y, 3.0), -DVec3::Z));
+            through.push((DVec3::new(x, y, -2.0), DVec3::Z));
+        }
+    }
+    for j in 0..16 {
+        let t = std::f64::consts::TAU * j as f64 / 16.0;
+        let d = DVec3::new(0.8 * t.cos(), 0.8 * t.sin(), -1.0);
+        let centre = DVec3::new(0.0, 0.0, 0.5);
+        through.push((centre - 3.0 * d, d));
+    }
+    let hits = trace(&part, &through);
+    for ((o, d), hit) in through.iter().zip(&hits) {
+        assert!(
+            hit.is_none(),
+            "ray from {o} along {d} through the hole hit {}",
+            hit.as_ref().unwrap().point
+        );
+    }
+    // Just outside the fillet's outer circle (radius HOLE + FILLET), every 15 degrees.
+    let outside: Vec<(DVec3, DVec3)> = (0..24)
+        .map(|j| {
+            let t = std::f64::consts::TAU * j as f64 / 24.0;
+            let r = (a + f) * 1.01;
+            (DVec3::new(r * t.cos(), r * t.sin(), 3.0), -DVec3::Z)
+        })
+        .collect();
+    for ((o, _), hit) in outside.iter().zip(trace(&part, &outside)) {
+        let hit = hit.unwrap_or_else(|| panic!("ray down at {o} missed the top plane"));
+        assert!((hit.point.z - 1.0).abs() < 1e-5, "at {o}: hit {}", hit.point);
+    }
+}
+
 #[test]
 fn info_reports_units_faces_and_projections() {
     let dir = tempfile::tempdir().unwrap();
