@@ -16,6 +16,14 @@ struct Hit {
 }
 
 fn trace(scene: &std::path::Path, rays: &[(DVec3, DVec3)]) -> Vec<Option<Hit>> {
+    trace_full(scene, rays)
+        .into_iter()
+        .map(|h| h.map(|(point, _)| Hit { point }))
+        .collect()
+}
+
+/// The hit point and normal of each ray, `None` for a miss.
+fn trace_full(scene: &std::path::Path, rays: &[(DVec3, DVec3)]) -> Vec<Option<(DVec3, DVec3)>> {
     let dir = scene.parent().unwrap();
     let file = dir.join("rays.txt");
     let text: String = rays
@@ -35,13 +43,14 @@ fn trace(scene: &std::path::Path, rays: &[(DVec3, DVec3)]) -> Vec<Option<Hit>> {
         .skip(1)
         .map(|l| {
             let f: Vec<&str> = l.split(',').collect();
-            (f[1] == "1").then(|| Hit {
-                point: DVec3::new(
-                    f[7].parse().unwrap(),
-                    f[8].parse().unwrap(),
-                    f[9].parse().unwrap(),
-                ),
-            })
+            let v = |k: usize| {
+                DVec3::new(
+                    f[k].parse().unwrap(),
+                    f[k + 1].parse().unwrap(),
+                    f[k + 2].parse().unwrap(),
+                )
+            };
+            (f[1] == "1").then(|| (v(7), v(10)))
         })
         .collect()
 }
@@ -190,7 +199,53 @@ fn rays_through_the_hole_pass_and_just_outside_it_hit_the_top() {
         .collect();
     for ((o, _), hit) in outside.iter().zip(trace(&part, &outside)) {
         let hit = hit.unwrap_or_else(|| panic!("ray down at {o} missed the top plane"));
-        assert!((hit.point.z - 1.0).abs() < 1e-5, "at {o}: hit {}", hit.point);
+        assert!(
+            (hit.point.z - 1.0).abs() < 1e-5,
+            "at {o}: hit {}",
+            hit.point
+        );
+    }
+}
+
+/// `same_sense` false turns the face's normal around (ISO 10303-42 §5.4.23) and changes
+/// nothing else: a plane z = 0 with normal +z, a square face with a square hole, read both
+/// ways; the hit points agree, the normals are +z and −z, the hole stays a hole.
+#[test]
+fn same_sense_false_turns_the_normal_and_keeps_the_trims() {
+    let dir = tempfile::tempdir().unwrap();
+    let square = |h: f64| [(-h, -h), (h, -h), (h, h), (-h, h)].map(|(x, y)| DVec3::new(x, y, 0.0));
+    let rays = [
+        (DVec3::new(0.7, 0.2, 2.0), -DVec3::Z),
+        (DVec3::new(-0.3, -0.8, -2.0), DVec3::Z),
+        (DVec3::new(0.1, 0.1, 2.0), -DVec3::Z),
+    ];
+    let mut normals = Vec::new();
+    for same_sense in [true, false] {
+        let mut w = step_support::StepWriter::default();
+        let ax = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
+        let plane = w.add(format!("PLANE('',#{ax})"));
+        let outer = w.polygon_bound(&square(1.0), true);
+        let hole = w.polygon_bound(&square(0.25), false);
+        w.face_with_sense(&[outer, hole], plane, same_sense);
+        let path = dir.path().join(format!("sense_{same_sense}.step"));
+        std::fs::write(&path, w.finish()).unwrap();
+        let hits = trace_full(&path, &rays);
+        for (k, want) in [DVec3::new(0.7, 0.2, 0.0), DVec3::new(-0.3, -0.8, 0.0)]
+            .iter()
+            .enumerate()
+        {
+            let (point, _) = hits[k].unwrap_or_else(|| panic!("ray {k} missed"));
+            assert!(point.distance(*want) < 1e-6, "{point} vs {want}");
+        }
+        assert!(
+            hits[2].is_none(),
+            "the hole is kept with same_sense {same_sense}"
+        );
+        normals.push(hits[0].unwrap().1);
+    }
+    let want = [DVec3::Z, -DVec3::Z];
+    for (n, w) in normals.iter().zip(want) {
+        assert!(n.normalize().distance(w) < 1e-6, "normal {n}, expected {w}");
     }
 }
 

@@ -483,12 +483,16 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
                 .collect(),
         });
     }
+    let mut surface = Surface {
+        geometry: SurfaceGeometry::Nurbs(nurbs),
+        trims,
+        trim_space,
+    };
+    if !face.same_sense {
+        surface.flip_sides();
+    }
     Ok(FaceOutcome {
-        surface: Surface {
-            geometry: SurfaceGeometry::Nurbs(nurbs),
-            trims,
-            trim_space,
-        },
+        surface,
         projection_error,
         projected_edges,
     })
