@@ -7,7 +7,7 @@
 mod common;
 mod step_support;
 
-use common::{run, stderr, stdout};
+use common::{run, stderr, stdout, trace_hits};
 use glam::DVec3;
 use step_support::{FILLET, HOLE, PLATE, bracket};
 
@@ -16,42 +16,9 @@ struct Hit {
 }
 
 fn trace(scene: &std::path::Path, rays: &[(DVec3, DVec3)]) -> Vec<Option<Hit>> {
-    trace_full(scene, rays)
+    trace_hits(scene, rays)
         .into_iter()
         .map(|h| h.map(|(point, _)| Hit { point }))
-        .collect()
-}
-
-/// The hit point and normal of each ray, `None` for a miss.
-fn trace_full(scene: &std::path::Path, rays: &[(DVec3, DVec3)]) -> Vec<Option<(DVec3, DVec3)>> {
-    let dir = scene.parent().unwrap();
-    let file = dir.join("rays.txt");
-    let text: String = rays
-        .iter()
-        .map(|(o, d)| format!("{} {} {} {} {} {}\n", o.x, o.y, o.z, d.x, d.y, d.z))
-        .collect();
-    std::fs::write(&file, text).unwrap();
-    let o = run(&[
-        "trace",
-        scene.to_str().unwrap(),
-        "--rays",
-        file.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    stdout(&o)
-        .lines()
-        .skip(1)
-        .map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            let v = |k: usize| {
-                DVec3::new(
-                    f[k].parse().unwrap(),
-                    f[k + 1].parse().unwrap(),
-                    f[k + 2].parse().unwrap(),
-                )
-            };
-            (f[1] == "1").then(|| (v(7), v(10)))
-        })
         .collect()
 }
 
@@ -229,7 +196,7 @@ fn same_sense_false_turns_the_normal_and_keeps_the_trims() {
         w.face_with_sense(&[outer, hole], plane, same_sense);
         let path = dir.path().join(format!("sense_{same_sense}.step"));
         std::fs::write(&path, w.finish()).unwrap();
-        let hits = trace_full(&path, &rays);
+        let hits = trace_hits(&path, &rays);
         for (k, want) in [DVec3::new(0.7, 0.2, 0.0), DVec3::new(-0.3, -0.8, 0.0)]
             .iter()
             .enumerate()

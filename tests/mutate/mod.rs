@@ -3,6 +3,8 @@
 //! Shared by the in-process parser fuzzing (`tests/robust_parsers.rs`) and the hand-run
 //! mutation run through the binary (`benches/mutation_run.rs`).
 
+#![allow(dead_code)] // each including target uses its own part: text or bytes
+
 use proptest::prelude::*;
 
 /// One way of damaging a text.
