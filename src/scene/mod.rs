@@ -3,6 +3,7 @@
 //! (OBJ via tobj, glTF via gltf). Every reader reports errors as `file:line:col: what was
 //! expected`; every writer writes to a temporary name and renames.
 
+pub mod animation;
 pub mod bpt;
 pub mod convert;
 pub mod error;

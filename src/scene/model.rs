@@ -176,6 +176,8 @@ pub struct Scene {
     pub max_depth: u32,
     /// Samples per pixel, unless `render --spp` says otherwise (`None`: one).
     pub samples: Option<u32>,
+    /// How the camera moves over the frames of an animation; `None`: it stands still.
+    pub animation: Option<super::animation::CameraPath>,
     pub lights: Vec<Light>,
     pub materials: Vec<Material>,
     pub objects: Vec<Object>,
@@ -209,6 +211,7 @@ impl Scene {
             ambient: DEFAULT_AMBIENT,
             max_depth: DEFAULT_MAX_DEPTH,
             samples: None,
+            animation: None,
             lights: Vec::new(),
             materials: vec![Material::default_named("default")],
             objects,
