@@ -246,3 +246,27 @@ fn the_scene_samples_field_is_the_default_spp() {
     assert_eq!(decode(&s), decode(&four));
     assert!(decode(&s) != decode(&render_ok(&d.join("1.png"), &["--spp", "1"])));
 }
+
+#[test]
+fn gltf_is_framed_y_up_by_default_and_up_is_refused_for_scenes() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let gltf = testdata("quad_mesh.gltf");
+    let img = |name: &str, extra: &[&str]| {
+        let out = d.join(name);
+        let o = render(&gltf, &out, (16, 16), extra);
+        assert!(o.status.success(), "{}", stderr(&o));
+        image::open(&out).unwrap().to_rgba8().into_raw()
+    };
+    let default = img("d.png", &[]);
+    assert!(default == img("y.png", &["--up", "y"]));
+    assert!(default != img("z.png", &["--up", "z"]));
+    let o = render(
+        &testdata("teapot.ron"),
+        &d.join("t.png"),
+        SIZE,
+        &["--up", "y"],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("bare geometry"), "{}", stderr(&o));
+}

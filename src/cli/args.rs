@@ -535,9 +535,15 @@ pub struct AccuracyArgs {
     pub quiet: bool,
 }
 
-/// Overrides of the scene camera's image size.
+/// Overrides of the scene camera's image size, and of the up axis bare geometry is framed
+/// with.
 #[derive(Debug, Args, Clone, Copy)]
 pub struct ImageSizeArgs {
+    /// Bare geometry only: the axis that points up in the model, for the default camera
+    /// (default: y for glTF, by its specification; z otherwise). In a RON scene, give the
+    /// object `up: Y` instead.
+    #[arg(long, value_enum)]
+    pub up: Option<crate::scene::model::Axis>,
     /// Override the camera's image width.
     #[arg(long)]
     pub width: Option<u32>,
@@ -547,14 +553,21 @@ pub struct ImageSizeArgs {
 }
 
 impl ImageSizeArgs {
-    /// Applies the overrides to `camera`, refusing a zero size.
-    pub fn apply(&self, camera: &mut crate::scene::Camera) -> anyhow::Result<()> {
+    /// Applies the overrides to the scene read from `path`, refusing a zero size; bare
+    /// geometry is framed again for the new size and `--up`.
+    pub fn apply(
+        &self,
+        path: &std::path::Path,
+        scene: &mut crate::scene::Scene,
+    ) -> anyhow::Result<()> {
         anyhow::ensure!(
             self.width != Some(0) && self.height != Some(0),
             "--width and --height must be at least 1"
         );
+        let camera = &mut scene.camera;
         camera.width = self.width.unwrap_or(camera.width);
         camera.height = self.height.unwrap_or(camera.height);
+        crate::scene::load::reframe(path, scene, self.up)?;
         Ok(())
     }
 }

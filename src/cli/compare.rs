@@ -62,7 +62,7 @@ fn render(scene: &Scene, quiet: bool, label: &str, pool: &rayon::ThreadPool) -> 
 pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     let pool = thread_pool(args.threads)?;
     let mut scene = load_scene(&args.scene)?;
-    args.size.apply(&mut scene.camera)?;
+    args.size.apply(&args.scene, &mut scene)?;
     std::fs::create_dir_all(&args.out_dir)
         .with_context(|| format!("creating {}", args.out_dir.display()))?;
     if !args.quiet {

@@ -128,7 +128,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     }
     let pool = thread_pool(args.threads)?;
     let mut prepared = prepare(&args.scene, &args.kernel)?;
-    args.size.apply(&mut prepared.scene.camera)?;
+    args.size.apply(&args.scene, &mut prepared.scene)?;
     let plan = EffectPlan::for_scene(&prepared.scene);
     eprintln!("{plan}");
     let still = prepared.scene.camera.clone();

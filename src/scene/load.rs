@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use super::error::LoadError;
-use super::model::{Geometry, Object, Scene, Surface};
+use super::model::{Axis, Geometry, Object, Scene, Surface};
 use super::{bpt, mesh, obj, pbrt, ron_format};
 
 /// The kinds of input file we read, by extension.
@@ -66,6 +66,30 @@ pub fn load_geometry(path: &Path) -> Result<Geometry, LoadError> {
     }
 }
 
+/// The up axis a format's convention gives bare geometry: y for glTF (glTF 2.0 §3.4, "glTF
+/// uses a right-handed coordinate system ... +Y is up"), z for everything else (CAD
+/// formats, and ours).
+pub fn default_up(kind: InputKind) -> Axis {
+    match kind {
+        InputKind::Gltf => Axis::Y,
+        _ => Axis::Z,
+    }
+}
+
+/// `--up`: frames bare geometry read from `path` with `up` pointing up instead of its
+/// format's default. A RON scene has its own camera, so it is refused there.
+pub fn reframe(path: &Path, scene: &mut Scene, up: Option<Axis>) -> Result<(), LoadError> {
+    let Some(up) = up else { return Ok(()) };
+    if InputKind::of(path) == Some(InputKind::Ron) {
+        return Err(LoadError::invalid(
+            path,
+            "--up frames bare geometry; in a scene, set the camera, or give an object `up: Y`",
+        ));
+    }
+    scene.frame_bare(up);
+    Ok(())
+}
+
 /// Reads a scene: a RON scene file, or bare geometry framed by a default camera and light.
 /// Scenes whose coordinates do not fit `f32` after transforms are refused.
 pub fn load_scene(path: &Path) -> Result<Scene, LoadError> {
@@ -123,11 +147,15 @@ fn read_any_scene(path: &Path) -> Result<Scene, LoadError> {
                 .file_name()
                 .map(|n| n.to_string_lossy().into_owned())
                 .unwrap_or_default();
-            Ok(Scene::framing(vec![Object {
-                name,
-                material: 0,
-                geometry,
-            }]))
+            let kind = InputKind::of(path).unwrap_or(InputKind::Bpt);
+            Ok(Scene::framing_up(
+                vec![Object {
+                    name,
+                    material: 0,
+                    geometry,
+                }],
+                default_up(kind),
+            ))
         }
     }
 }

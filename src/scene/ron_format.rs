@@ -135,6 +135,10 @@ pub struct ObjectDef {
     pub geometry: GeometryDef,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
+    /// The axis that is up in the object's geometry (`X`, `Y` or `Z`, default `Z`): a
+    /// y-up model is turned to stand in the z-up scene before its transforms.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub up: Option<Axis>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub transform: Vec<TransformDef>,
 }
@@ -285,10 +289,8 @@ fn build_scene(path: &Path, file: SceneFile) -> Result<Scene, LoadError> {
                     .collect::<Result<_, _>>()?,
             ),
         };
-        let m = o
-            .transform
-            .iter()
-            .fold(DAffine3::IDENTITY, |acc, t| t.to_affine() * acc);
+        let stand = DAffine3::from_mat3(o.up.unwrap_or(Axis::Z).to_z_up());
+        let m = o.transform.iter().fold(stand, |acc, t| t.to_affine() * acc);
         if m != DAffine3::IDENTITY {
             match &mut geometry {
                 Geometry::Surfaces(s) => s.iter_mut().for_each(|s| s.transform(&m)),
@@ -591,6 +593,7 @@ pub fn scene_to_file(scene: &Scene) -> Result<SceneFile, String> {
             name: Some(o.name.clone()),
             geometry: GeometryDef::Surfaces(defs),
             material: Some(scene.materials[o.material].name.clone()),
+            up: None,
             transform: Vec::new(),
         });
     }
