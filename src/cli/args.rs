@@ -151,6 +151,8 @@ pub struct TeapotsArgs {
 pub struct InfoArgs {
     /// Scene (.ron) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb).
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
@@ -160,6 +162,8 @@ pub struct InfoArgs {
 pub struct ImportArgs {
     /// Input scene or geometry file.
     pub input: PathBuf,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Output: .ron (scene, geometry inline), .bpt (non-rational patches) or .obj
     /// (free-form Bézier patches).
     #[arg(short, long)]
@@ -170,6 +174,8 @@ pub struct ImportArgs {
 pub struct ConvertArgs {
     /// Input with NURBS surfaces (.obj, .pbrt, .ron) or any other supported geometry.
     pub input: PathBuf,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Output: .obj (free-form Bézier), .bpt (non-rational only) or .ron.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -245,6 +251,32 @@ impl std::str::FromStr for TerminationChoice {
 /// parameter cells go per direction (`kernel::subdivision::param`).
 pub const MAX_DEPTH: u8 = 64;
 
+/// How bare mesh files are read, for every command that takes a scene.
+#[derive(Debug, Args, Clone, Copy, Default)]
+pub struct MeshArgs {
+    /// Read a bare mesh file (OBJ polygons, glTF) as the control cage of a subdivision
+    /// surface and use its limit surface (boundaries sharp, as OpenSubdiv's EDGE_ONLY).
+    /// `trace` then reports as `patch` the quad after the first Catmull–Clark step (cage
+    /// face f with n corners gives quads Σ_{g<f} n_g + 0..n, one per corner) and (u, v)
+    /// in that quad. In a RON scene write `geometry: Subdivision(File("cage.obj"))`.
+    #[arg(long, value_enum, value_name = "SCHEME")]
+    pub subdivide: Option<SubdivideChoice>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SubdivideChoice {
+    /// Catmull–Clark (1978), as Dammertz §2.9 ray traces it.
+    CatmullClark,
+}
+
+impl MeshArgs {
+    pub fn load_options(&self) -> crate::scene::LoadOptions {
+        crate::scene::LoadOptions {
+            subdivide: self.subdivide == Some(SubdivideChoice::CatmullClark),
+        }
+    }
+}
+
 /// Options shared by every command that intersects rays.
 #[derive(Debug, Args, Clone)]
 pub struct KernelArgs {
@@ -309,6 +341,8 @@ pub enum AccelChoice {
 pub struct RenderArgs {
     /// Scene (.ron) or bare geometry.
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Output image: .png (8-bit sRGB) or .exr (linear f32 RGBA).
     #[arg(short, long)]
     pub output: PathBuf,
@@ -394,6 +428,8 @@ pub struct CompletionsArgs {
 pub struct TraceArgs {
     /// Scene (.ron) or bare geometry.
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Ray file: `ox oy oz dx dy dz [tmin [tmax]]` per line.
     #[arg(long)]
     pub rays: PathBuf,
@@ -411,6 +447,8 @@ pub struct TraceArgs {
 pub struct BvhArgs {
     /// Scene (.ron) or bare geometry.
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Output BVH file.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -421,6 +459,8 @@ pub struct BvhArgs {
 pub struct TessellateArgs {
     /// Scene (.ron) or bare geometry.
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Output mesh: .obj, .gltf (buffer embedded) or .glb.
     #[arg(short, long)]
     pub output: PathBuf,
@@ -487,6 +527,8 @@ pub struct DiffArgs {
 pub struct CompareArgs {
     /// Scene (.ron) or bare geometry.
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Triangles per patch of each tessellation to compare (even counts 2·u·v).
     #[arg(long, value_delimiter = ',', default_values_t = crate::bench::accuracy::DEFAULT_TRIANGLES)]
     pub triangles: Vec<u32>,
@@ -507,6 +549,8 @@ pub struct CompareArgs {
 pub struct AccuracyArgs {
     /// Scene (.ron) or bare geometry.
     pub scene: PathBuf,
+    #[command(flatten)]
+    pub mesh: MeshArgs,
     /// Trace these rays (`ox oy oz dx dy dz [tmin [tmax]]` per line) instead of the
     /// camera's primary rays.
     #[arg(long)]

@@ -9,12 +9,12 @@ use crate::bench::accuracy::{self, Method, plot};
 use crate::cli::args::AccuracyArgs;
 use crate::render::camera::CameraRays;
 use crate::scene::error::read_text;
-use crate::scene::load_scene;
+use crate::scene::load_scene_with;
 use crate::scene::rays::{RayQuery, parse_rays};
 use crate::scene::write::write_atomic;
 
 pub fn run(args: AccuracyArgs) -> anyhow::Result<ExitCode> {
-    let mut scene = load_scene(&args.scene)?;
+    let mut scene = load_scene_with(&args.scene, args.mesh.load_options())?;
     if let Some(n) = args.size {
         anyhow::ensure!(n > 0, "--size must be at least 1");
         scene.camera.width = n;

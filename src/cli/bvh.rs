@@ -5,10 +5,10 @@ use std::time::Instant;
 
 use crate::accel::scene::SceneGeometry;
 use crate::cli::args::BvhArgs;
-use crate::scene::load_scene;
+use crate::scene::load_scene_with;
 
 pub fn run(args: BvhArgs) -> anyhow::Result<ExitCode> {
-    let scene = load_scene(&args.scene)?;
+    let scene = load_scene_with(&args.scene, args.mesh.load_options())?;
     let start = Instant::now();
     let geometry = SceneGeometry::build(&scene);
     let build = start.elapsed().as_secs_f64();

@@ -23,7 +23,7 @@ use crate::render::integrator::{Integrator, TraceSettings};
 use crate::render::plan::EffectPlan;
 use crate::render::renderer::{progress_bar, render_image};
 use crate::scene::write::write_atomic;
-use crate::scene::{Scene, load_scene};
+use crate::scene::{Scene, load_scene_with};
 use crate::tessellate::{TessellationMode, tessellate_scene};
 
 /// One line of the table.
@@ -61,7 +61,7 @@ fn render(scene: &Scene, quiet: bool, label: &str, pool: &rayon::ThreadPool) -> 
 
 pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     let pool = thread_pool(args.threads)?;
-    let mut scene = load_scene(&args.scene)?;
+    let mut scene = load_scene_with(&args.scene, args.mesh.load_options())?;
     args.size.apply(&args.scene, &mut scene)?;
     std::fs::create_dir_all(&args.out_dir)
         .with_context(|| format!("creating {}", args.out_dir.display()))?;

@@ -5,10 +5,10 @@ use std::process::ExitCode;
 
 use crate::cli::args::ConvertArgs;
 use crate::scene::convert::convert_scene;
-use crate::scene::{load_scene, write::write_scene_as};
+use crate::scene::{load_scene_with, write::write_scene_as};
 
 pub fn run(args: ConvertArgs) -> anyhow::Result<ExitCode> {
-    let scene = load_scene(&args.input)?;
+    let scene = load_scene_with(&args.input, args.mesh.load_options())?;
     let (converted, report) = convert_scene(&scene);
     write_scene_as(&args.output, &converted)?;
     let mut out = std::io::stdout().lock();

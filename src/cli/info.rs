@@ -4,11 +4,11 @@ use std::io::Write;
 use std::process::ExitCode;
 
 use crate::cli::args::InfoArgs;
-use crate::scene::load_scene;
+use crate::scene::load_scene_with;
 use crate::scene::summary::summarize;
 
 pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
-    let scene = load_scene(&args.scene)?;
+    let scene = load_scene_with(&args.scene, args.mesh.load_options())?;
     let s = summarize(&scene);
     let mut out = std::io::stdout().lock();
     if args.json {

@@ -127,7 +127,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         .into());
     }
     let pool = thread_pool(args.threads)?;
-    let mut prepared = prepare(&args.scene, &args.kernel)?;
+    let mut prepared = prepare(&args.scene, &args.mesh, &args.kernel)?;
     args.size.apply(&args.scene, &mut prepared.scene)?;
     let plan = EffectPlan::for_scene(&prepared.scene);
     eprintln!("{plan}");

@@ -8,13 +8,14 @@ use anyhow::Context;
 
 use crate::accel::scene::{Precision, SceneGeometry};
 use crate::cli::args::{
-    AccelChoice, HeuristicChoice, KernelArgs, KernelChoice, PrecisionChoice, TerminationChoice,
+    AccelChoice, HeuristicChoice, KernelArgs, KernelChoice, MeshArgs, PrecisionChoice,
+    TerminationChoice,
 };
 use crate::kernel::cached::{CachedConfig, DEFAULT_CACHE_BYTES, DEFAULT_MAX_DEPTH};
 use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig, Termination};
 use crate::kernel::toth::TothConfig;
 use crate::render::camera::CameraRays;
-use crate::scene::{Camera, Scene, load_scene};
+use crate::scene::{Camera, Scene, load_scene_with};
 
 /// The kernel path selected by the flags, or why the flags do not go together; `camera`
 /// sizes the pixels of adaptive termination.
@@ -86,13 +87,13 @@ pub struct Prepared {
 
 /// Loads the scene and prepares its geometry: builds the BVH or loads `--bvh`, or builds
 /// the grid for `--accel grid`.
-pub fn prepare(scene_path: &Path, args: &KernelArgs) -> anyhow::Result<Prepared> {
+pub fn prepare(scene_path: &Path, mesh: &MeshArgs, args: &KernelArgs) -> anyhow::Result<Prepared> {
     anyhow::ensure!(
         args.accel == AccelChoice::Bvh || args.bvh.is_none(),
         "--bvh loads a BVH file, which --accel grid does not use; drop one of the two flags"
     );
     let start = Instant::now();
-    let scene = load_scene(scene_path)?;
+    let scene = load_scene_with(scene_path, mesh.load_options())?;
     let load_seconds = start.elapsed().as_secs_f64();
     let start = Instant::now();
     let geometry = match (args.accel, &args.bvh) {

@@ -7,7 +7,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::cli::args::TessellateArgs;
-use crate::scene::{LoadError, load_scene};
+use crate::scene::{LoadError, load_scene_with};
 use crate::tessellate::{
     MeshFormat, TessellationMode, TessellationReport, tessellate_scene, write_mesh_scene,
 };
@@ -46,7 +46,7 @@ pub fn run(args: TessellateArgs) -> anyhow::Result<ExitCode> {
         )
         .into());
     }
-    let scene = load_scene(&args.scene)?;
+    let scene = load_scene_with(&args.scene, args.mesh.load_options())?;
     let start = Instant::now();
     let (meshes, report) = tessellate_scene(&scene, mode(&args))?;
     let seconds = start.elapsed().as_secs_f64();

@@ -11,6 +11,7 @@ use crate::accel::scene::{Precision, QueryStats, SceneGeometry, SceneHit};
 use crate::cli::args::TraceArgs;
 use crate::cli::setup::{precision, prepare, thread_pool};
 use crate::geom::Ray;
+use crate::scene::Scene;
 use crate::scene::error::read_text;
 use crate::scene::rays::{RayQuery, parse_rays};
 use crate::scene::write::write_atomic;
@@ -21,13 +22,17 @@ pub const TRACE_HEADER: &str = "ray,hit,t,object,patch,u,v,px,py,pz,nx,ny,nz";
 pub fn run(args: TraceArgs) -> anyhow::Result<ExitCode> {
     let src = read_text(&args.rays)?;
     let rays = parse_rays(&args.rays, &src)?;
-    let prepared = prepare(&args.scene, &args.kernel)?;
+    let prepared = prepare(&args.scene, &args.mesh, &args.kernel)?;
     let precision = precision(&args.kernel, &prepared.scene.camera)?;
     let pool = thread_pool(args.threads)?;
     let rows: Vec<String> = pool.install(|| {
         rays.par_iter()
             .enumerate()
-            .map(|(i, q)| row(i, trace_one(&prepared.geometry, q, &precision)))
+            .map(|(i, q)| {
+                let hit = trace_one(&prepared.geometry, q, &precision)
+                    .map(|(h, o, d)| (in_contract_terms(&prepared.scene, h), o, d));
+                row(i, hit)
+            })
             .collect()
     });
     let write = |w: &mut dyn Write| -> std::io::Result<()> {
@@ -68,6 +73,15 @@ fn trace_one(
             Some((hit, q.origin, q.dir))
         }
     }
+}
+
+/// The hit with the patch and (u, v) the contract reports: for a subdivision surface the
+/// quad after the first Catmull–Clark step ([`crate::scene::Object::trace_patch`]).
+fn in_contract_terms(scene: &Scene, mut hit: SceneHit) -> SceneHit {
+    if let Some(object) = scene.objects.get(hit.object as usize) {
+        (hit.patch, hit.u, hit.v) = object.trace_patch(hit.patch, hit.u, hit.v);
+    }
+    hit
 }
 
 fn row(index: usize, hit: Option<(SceneHit, DVec3, DVec3)>) -> String {

@@ -13,6 +13,7 @@ pub mod interval;
 pub mod nurbs;
 pub mod ray;
 pub mod real;
+pub mod subdiv;
 pub mod trim;
 pub mod ulp;
 

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use super::error::LoadError;
 use super::model::{Axis, Geometry, Object, Scene, Surface};
-use super::{bpt, mesh, obj, pbrt, ron_format};
+use super::{bpt, cage, mesh, obj, pbrt, ron_format};
 
 /// The kinds of input file we read, by extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -90,10 +90,60 @@ pub fn reframe(path: &Path, scene: &mut Scene, up: Option<Axis>) -> Result<(), L
     Ok(())
 }
 
+/// Reads a polygon mesh file (OBJ polygons, glTF triangles) as a Catmull–Clark cage.
+pub fn load_subdivision(path: &Path) -> Result<Geometry, LoadError> {
+    let refuse = |what: &str| {
+        LoadError::invalid(
+            path,
+            format!(
+                "{what} is not a polygon mesh, so it cannot be a Catmull–Clark cage; expected an OBJ file of `f` faces, or glTF"
+            ),
+        )
+    };
+    match InputKind::of(path).ok_or_else(|| unknown_kind(path))? {
+        InputKind::Obj => {
+            let src = super::error::read_text(path)?;
+            if obj::is_freeform(&src) {
+                return Err(refuse("an OBJ file of free-form surfaces"));
+            }
+            Ok(Geometry::Subdivision(cage::read_obj_cage(path)?))
+        }
+        InputKind::Gltf => Ok(Geometry::Subdivision(cage::mesh_cage(
+            path,
+            &mesh::read_gltf(path)?,
+        )?)),
+        InputKind::Bpt => Err(refuse("a .bpt file of Bézier patches")),
+        InputKind::Pbrt => Err(refuse("a pbrt file")),
+        InputKind::Ron => Err(refuse("a RON scene")),
+    }
+}
+
+/// How bare geometry files are read.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LoadOptions {
+    /// Read a bare mesh file as a Catmull–Clark cage (`--subdivide catmull-clark`).
+    pub subdivide: bool,
+}
+
 /// Reads a scene: a RON scene file, or bare geometry framed by a default camera and light.
 /// Scenes whose coordinates do not fit `f32` after transforms are refused.
 pub fn load_scene(path: &Path) -> Result<Scene, LoadError> {
-    let scene = read_any_scene(path)?;
+    load_scene_with(path, LoadOptions::default())
+}
+
+/// [`load_scene`] with options for bare geometry.
+pub fn load_scene_with(path: &Path, options: LoadOptions) -> Result<Scene, LoadError> {
+    let scene = if options.subdivide {
+        if InputKind::of(path) == Some(InputKind::Ron) {
+            return Err(LoadError::invalid(
+                path,
+                "--subdivide applies to bare mesh files; in a RON scene write `geometry: Subdivision(File(\"cage.obj\"))`",
+            ));
+        }
+        bare_scene(path, load_subdivision(path)?)
+    } else {
+        read_any_scene(path)?
+    };
     check_f32_range(path, &scene)?;
     Ok(scene)
 }
@@ -141,21 +191,22 @@ pub fn check_f32_range(path: &Path, scene: &Scene) -> Result<(), LoadError> {
 fn read_any_scene(path: &Path) -> Result<Scene, LoadError> {
     match InputKind::of(path).ok_or_else(|| unknown_kind(path))? {
         InputKind::Ron => ron_format::read_scene(path),
-        _ => {
-            let geometry = load_geometry(path)?;
-            let name = path
-                .file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_default();
-            let kind = InputKind::of(path).unwrap_or(InputKind::Bpt);
-            Ok(Scene::framing_up(
-                vec![Object {
-                    name,
-                    material: 0,
-                    geometry,
-                }],
-                default_up(kind),
-            ))
-        }
+        _ => Ok(bare_scene(path, load_geometry(path)?)),
     }
+}
+
+fn bare_scene(path: &Path, geometry: Geometry) -> Scene {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let kind = InputKind::of(path).unwrap_or(InputKind::Bpt);
+    Scene::framing_up(
+        vec![Object {
+            name,
+            material: 0,
+            geometry,
+        }],
+        default_up(kind),
+    )
 }

@@ -5,6 +5,7 @@
 
 pub mod animation;
 pub mod bpt;
+pub mod cage;
 pub mod convert;
 pub mod error;
 pub mod generate;
@@ -20,5 +21,5 @@ pub mod text;
 pub mod write;
 
 pub use error::{LoadError, ParseError};
-pub use load::{load_geometry, load_scene};
+pub use load::{LoadOptions, load_geometry, load_scene, load_scene_with, load_subdivision};
 pub use model::*;

@@ -6,6 +6,7 @@ use glam::{DVec3, Vec3};
 use crate::geom::BezierPatch;
 use crate::geom::bbox::DAabb;
 use crate::geom::nurbs::NurbsSurface;
+use crate::geom::subdiv::SubdivisionSurface;
 use crate::geom::trim::{AxisMap, TrimLoop};
 
 /// Camera per the DESIGN.md contract.
@@ -121,6 +122,20 @@ impl TriangleMesh {
 pub enum Geometry {
     Surfaces(Vec<Surface>),
     Mesh(TriangleMesh),
+    /// A Catmull–Clark control cage and the Bézier patches of its limit surface
+    /// (Dammertz §2.9); its patches are numbered as [`SubdivisionSurface::patches`], and
+    /// `trace` reports the quad after the first step instead ([`Object::trace_patch`]).
+    Subdivision(SubdivisionSurface),
+}
+
+impl Geometry {
+    pub fn transform(&mut self, m: &glam::DAffine3) {
+        match self {
+            Geometry::Surfaces(s) => s.iter_mut().for_each(|s| s.transform(m)),
+            Geometry::Mesh(mesh) => mesh.transform(m),
+            Geometry::Subdivision(s) => s.transform(m),
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -144,6 +159,18 @@ impl Object {
                 })
                 .collect(),
             Geometry::Mesh(_) => Vec::new(),
+            Geometry::Subdivision(s) => s.patches.clone(),
+        }
+    }
+
+    /// The patch number and `(u, v)` that `trace` reports for a hit at `(u, v)` on patch
+    /// `patch` (contract order): for a subdivision surface the quad after the first
+    /// Catmull–Clark step and its parameters (see [`crate::geom::subdiv`]), otherwise
+    /// unchanged.
+    pub fn trace_patch(&self, patch: u32, u: f64, v: f64) -> (u32, f64, f64) {
+        match &self.geometry {
+            Geometry::Subdivision(s) => s.face_uv(patch as usize, u, v).unwrap_or((patch, u, v)),
+            _ => (patch, u, v),
         }
     }
 
@@ -161,6 +188,8 @@ impl Object {
                 })
                 .collect(),
             Geometry::Mesh(m) => m.positions.iter().copied().collect(),
+            // The limit surface lies in the convex hull of the cage.
+            Geometry::Subdivision(s) => s.cage.points.iter().copied().collect(),
         }
     }
 }

@@ -149,6 +149,9 @@ pub enum GeometryDef {
     File(String),
     /// Inline free-form surfaces.
     Surfaces(Vec<SurfaceDef>),
+    /// A Catmull–Clark surface: `Subdivision(File("cage.obj"))`, a polygon mesh (OBJ or
+    /// glTF) as the control cage, with sharp (`EDGE_ONLY`) boundaries.
+    Subdivision(Box<GeometryDef>),
 }
 
 #[derive(Debug, Serialize, Deserialize)]
@@ -278,6 +281,17 @@ fn build_scene(path: &Path, file: SceneFile) -> Result<Scene, LoadError> {
         };
         let mut geometry = match &o.geometry {
             GeometryDef::File(f) => super::load::load_geometry(&base.join(f))?,
+            GeometryDef::Subdivision(inner) => match inner.as_ref() {
+                GeometryDef::File(f) => super::load::load_subdivision(&base.join(f))?,
+                _ => {
+                    return Err(LoadError::invalid(
+                        path,
+                        format!(
+                            "object {index}: expected Subdivision(File(\"cage.obj\")): a cage is read from a mesh file"
+                        ),
+                    ));
+                }
+            },
             GeometryDef::Surfaces(defs) => Geometry::Surfaces(
                 defs.iter()
                     .enumerate()
@@ -292,13 +306,14 @@ fn build_scene(path: &Path, file: SceneFile) -> Result<Scene, LoadError> {
         let stand = DAffine3::from_mat3(o.up.unwrap_or(Axis::Z).to_z_up());
         let m = o.transform.iter().fold(stand, |acc, t| t.to_affine() * acc);
         if m != DAffine3::IDENTITY {
-            match &mut geometry {
-                Geometry::Surfaces(s) => s.iter_mut().for_each(|s| s.transform(&m)),
-                Geometry::Mesh(mesh) => mesh.transform(&m),
-            }
+            geometry.transform(&m);
         }
         let name = o.name.clone().unwrap_or_else(|| match &o.geometry {
             GeometryDef::File(f) => f.clone(),
+            GeometryDef::Subdivision(inner) => match inner.as_ref() {
+                GeometryDef::File(f) => f.clone(),
+                _ => format!("object{index}"),
+            },
             GeometryDef::Surfaces(_) => format!("object{index}"),
         });
         objects.push(Object {
@@ -556,8 +571,14 @@ pub fn scene_to_file(scene: &Scene) -> Result<SceneFile, String> {
     let tc = |v: Vec3| (v.x, v.y, v.z);
     let mut objects = Vec::new();
     for o in &scene.objects {
+        let limit_patches: Vec<Surface>;
         let surfaces = match &o.geometry {
             Geometry::Surfaces(s) => s,
+            // Written as its limit surface's Bézier patches.
+            Geometry::Subdivision(s) => {
+                limit_patches = s.patches.iter().cloned().map(Surface::bezier).collect();
+                &limit_patches
+            }
             Geometry::Mesh(_) => {
                 return Err(format!(
                     "object \"{}\" is a triangle mesh; RON scenes reference meshes by file",

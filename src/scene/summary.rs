@@ -66,6 +66,7 @@ pub fn summarize(scene: &Scene) -> SceneSummary {
                 0,
             ),
             Geometry::Mesh(m) => (0, 0, 0, m.indices.len()),
+            Geometry::Subdivision(_) => (1, 0, 0, 0),
         };
         patches += bez.len();
         nurbs += n;

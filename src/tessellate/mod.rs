@@ -142,6 +142,7 @@ pub fn tessellate_object(
             }
             tessellate_patches(&object.bezier_patches(), mode)?.mesh
         }
+        Geometry::Subdivision(_) => tessellate_patches(&object.bezier_patches(), mode)?.mesh,
     };
     let report = TessellationReport::of(&mesh);
     Ok((
