@@ -81,7 +81,7 @@ fn main() {
                     continue;
                 }
                 let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
-                if let Some(h) = intersect_f64(&patches[k], o, d, 0.0, f64::INFINITY, &cfg) {
+                if let Some(h) = intersect_f64(&patches[k], o, d, 0.0, f64::INFINITY, &cfg, None) {
                     pairs.push((ray, k, o + h.t * d));
                 }
             }
@@ -105,7 +105,7 @@ fn main() {
         errors.clear();
         for (ray, k, want) in &pairs {
             let before = s.splits;
-            if let Some(h) = intersect(&prepared[*k], ray, &cfg, &mut s) {
+            if let Some(h) = intersect(&prepared[*k], None, ray, &cfg, &mut s) {
                 hits += 1;
                 let got = (ray.origin + h.t * ray.dir).as_dvec3();
                 let b = prepared[*k].bounds();

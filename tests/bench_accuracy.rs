@@ -33,7 +33,7 @@ fn f64_reference_hits_a_rational_sphere_where_the_closed_form_says() {
         let disc = b * b - 4.0 * a * c;
         let nearest = patches
             .iter()
-            .filter_map(|p| intersect_f64(p, origin, dir, 0.0, f64::INFINITY, &cfg))
+            .filter_map(|p| intersect_f64(p, origin, dir, 0.0, f64::INFINITY, &cfg, None))
             .map(|h| h.t)
             .fold(f64::INFINITY, f64::min);
         if disc <= 0.0 {

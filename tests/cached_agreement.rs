@@ -17,7 +17,7 @@ fn cached_kernel_agrees_with_the_f64_reference_on_random_patches() {
     let cfg = CachedConfig::default();
     let mut stats = KernelStats::default();
     let a = agrees_with_reference(7, 40, |patch, ray| {
-        intersect(patch, ray, &cfg, false, &mut stats)
+        intersect(patch, None, ray, &cfg, false, &mut stats)
     });
     assert!(
         a.hits > 600 && a.misses > 300,
@@ -46,7 +46,7 @@ fn without_a_usable_cache_the_answers_are_the_same() {
     let cfg = CachedConfig::new(TothConfig::default(), 1, 1);
     let mut stats = KernelStats::default();
     let a = agrees_with_reference(8, 20, |patch, ray| {
-        intersect(patch, ray, &cfg, false, &mut stats)
+        intersect(patch, None, ray, &cfg, false, &mut stats)
     });
     assert!(a.hits > 300 && a.misses > 150);
     let c = stats.cached;
@@ -66,7 +66,7 @@ fn a_repeated_ray_starts_from_the_cached_tree() {
         let mut stats = KernelStats::default();
         let hits: Vec<_> = rays
             .iter()
-            .map(|r| intersect(&patch, r, &cfg, false, &mut stats))
+            .map(|r| intersect(&patch, None, r, &cfg, false, &mut stats))
             .collect();
         (hits, stats)
     };
@@ -100,6 +100,6 @@ fn a_repeated_ray_starts_from_the_cached_tree() {
     let fresh = CachedConfig::default();
     assert_eq!(cached_bytes(&fresh), 0);
     let mut s3 = KernelStats::default();
-    intersect(&patch, &rays[0], &fresh, false, &mut s3);
+    intersect(&patch, None, &rays[0], &fresh, false, &mut s3);
     assert_eq!(s3.cached.misses, 1);
 }

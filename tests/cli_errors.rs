@@ -116,8 +116,9 @@ fn ron_unknown_material() {
         );
     let c = file("mat.ron", &text);
     let err = info_fails(&c.path);
+    // Located at the object's `geometry:` key (line 11 of teapot.ron).
     assert!(
-        err.contains("mat.ron: object 0 uses material \"chrome\""),
+        err.contains("mat.ron:11:") && err.contains("object 0 uses material \"chrome\""),
         "{err}"
     );
 }

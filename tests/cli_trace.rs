@@ -2,30 +2,10 @@
 
 mod common;
 
-use common::{run, stderr, stdout, testdata};
-
-const HEADER: &str = "ray,hit,t,object,patch,u,v,px,py,pz,nx,ny,nz";
+use common::{run, stderr, testdata};
 
 fn trace(rays: &str, extra: &[&str]) -> Vec<Vec<String>> {
-    let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("rays.txt");
-    std::fs::write(&file, rays).unwrap();
-    let scene = testdata("teapot.ron");
-    let mut args = vec![
-        "trace",
-        scene.to_str().unwrap(),
-        "--rays",
-        file.to_str().unwrap(),
-    ];
-    args.extend_from_slice(extra);
-    let o = run(&args);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let out = stdout(&o);
-    let mut lines = out.lines();
-    assert_eq!(lines.next(), Some(HEADER));
-    lines
-        .map(|l| l.split(',').map(str::to_string).collect())
-        .collect()
+    common::trace_rows(&testdata("teapot.ron"), rays, extra)
 }
 
 #[test]

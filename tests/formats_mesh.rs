@@ -1,10 +1,11 @@
-//! Triangle meshes from OBJ (tobj) and glTF (gltf): the same cube from both.
+//! Triangle meshes from polygonal OBJ and glTF: the same cube from both.
 
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use patchtrace::scene::TriangleMesh;
-use patchtrace::scene::mesh::{read_gltf, read_obj_mesh};
+use patchtrace::scene::gltf_mesh::read_gltf;
+use patchtrace::scene::mesh::read_obj_mesh;
 
 fn testdata(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -67,10 +68,10 @@ fn non_triangle_gltf_primitives_are_refused() {
     let path = dir.path().join("lines.gltf");
     std::fs::write(&path, lines).unwrap();
     let e = read_gltf(&path).unwrap_err().to_string();
-    assert!(
-        e.starts_with(&format!("{}: glTF mesh 0", path.display())),
-        "{e}"
-    );
+    // Located at the mesh in the JSON text.
+    let place = format!("{}:", path.display());
+    assert!(e.starts_with(&place), "{e}");
+    assert!(e.contains(": glTF mesh 0 (\""), "{e}");
     assert!(e.contains("expected triangles, found mode Lines"), "{e}");
 }
 
@@ -80,9 +81,10 @@ fn mesh_errors_name_the_file() {
     let empty = dir.path().join("empty.obj");
     std::fs::write(&empty, "v 0 0 0\nv 1 0 0\n").unwrap();
     let e = read_obj_mesh(&empty).unwrap_err().to_string();
+    // At the end of the last line.
     assert!(
         e.starts_with(&format!(
-            "{}: expected at least one triangle",
+            "{}:2:8: expected at least one face",
             empty.display()
         )),
         "{e}"
@@ -90,7 +92,7 @@ fn mesh_errors_name_the_file() {
     let missing = dir.path().join("missing.gltf");
     let e = read_gltf(&missing).unwrap_err().to_string();
     assert!(
-        e.starts_with(&format!("{}: glTF:", missing.display())),
+        e.starts_with(&format!("{}: ", missing.display())) && e.contains("No such file"),
         "{e}"
     );
 }

@@ -480,3 +480,41 @@ fn curve_point_counts_must_match_the_knots() {
         "expected a parameter vertex with u and v, `vp` 1 has only u",
     );
 }
+
+#[test]
+fn surf_range_restricts_the_surface_exactly() {
+    // A bilinear B-spline plane x = u over [0, 4] × [0, 2], restricted by `surf 1 3 0 2.5`
+    // (t1 past the domain, as exporters round, is clipped to it); a Bézier surface of two
+    // spans restricted to [0.5, 1.5] keeps parts of both.
+    let src = "v 0 0 0\nv 4 0 0\nv 0 2 0\nv 4 2 1\ncstype bspline\ndeg 1 1\nsurf 1 3 0 2.5 1 2 3 4\nparm u 0 0 4 4\nparm v 0 0 2 2\nend\n\
+        v 0 0 5\nv 1 0 5\nv 2 0 5\nv 0 1 5\nv 1 1 5\nv 2 1 6\ncstype bezier\ndeg 1 1\nsurf 0.5 1.5 0 1 5 6 7 8 9 10\nparm u 0 1 2\nparm v 0 1\nend\n";
+    let surfaces =
+        patchtrace::scene::obj::parse_obj_freeform(std::path::Path::new("range.obj"), src)
+            .expect("parses");
+    let patchtrace::scene::SurfaceGeometry::Nurbs(n) = &surfaces[0].geometry else {
+        panic!("a B-spline surface");
+    };
+    let d = n.domain();
+    assert_eq!((d.u0, d.u1, d.v0, d.v1), (1.0, 3.0, 0.0, 2.0));
+    // The plane's height is u v / 8 (bilinear through the corners): check it on the range.
+    for (u, v) in [(1.0, 0.0), (3.0, 2.0), (2.2, 0.7)] {
+        let p = n.eval(u, v);
+        assert!(
+            (p - glam::DVec3::new(u, v, u * v / 8.0)).length() < 1e-14,
+            "{p}"
+        );
+    }
+    let beziers: Vec<_> = surfaces[1..]
+        .iter()
+        .map(|s| match &s.geometry {
+            patchtrace::scene::SurfaceGeometry::Bezier(p) => p.clone(),
+            _ => panic!("Bézier patches"),
+        })
+        .collect();
+    assert_eq!(beziers.len(), 2);
+    assert_eq!((beziers[0].domain().u0, beziers[0].domain().u1), (0.5, 1.0));
+    assert_eq!((beziers[1].domain().u0, beziers[1].domain().u1), (1.0, 1.5));
+    // Local (0, 0) of the first piece is global u = 0.5: x = 0.5 on the first span.
+    assert!((beziers[0].eval(0.0, 0.0) - glam::DVec3::new(0.5, 0.0, 5.0)).length() < 1e-14);
+    assert!((beziers[1].eval(1.0, 1.0) - glam::DVec3::new(1.5, 1.0, 5.5)).length() < 1e-14);
+}

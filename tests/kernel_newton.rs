@@ -104,7 +104,7 @@ fn check(rational: bool, patches: usize, rays_per_patch: usize, seed: u64) -> Ta
             let ray = Ray::new(origin.as_vec3(), dir.as_vec3());
             let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
             let mut stats = KernelStats::default();
-            let got = intersect(&prepared, &ray, &cfg, &mut stats);
+            let got = intersect(&prepared, None, &ray, &cfg, &mut stats);
             let seeds: Vec<(f64, f64)> = got.iter().map(|h| (h.u as f64, h.v as f64)).collect();
             let want = nearest_root(&p, o, d, GRID, &seeds);
             tally.rays += 1;
@@ -195,15 +195,15 @@ fn hit_box_entry_is_not_behind_tmin_or_beyond_tmax() {
     let ray = Ray::new(origin.as_vec3(), (target - origin).as_vec3());
     let cfg = SubdivisionConfig::default();
     let mut s = KernelStats::default();
-    let full = intersect(&prepared, &ray, &cfg, &mut s).expect("aimed at the surface");
+    let full = intersect(&prepared, None, &ray, &cfg, &mut s).expect("aimed at the surface");
     let short = Ray { tmax: 0.9, ..ray };
-    assert!(intersect(&prepared, &short, &cfg, &mut s).is_none());
+    assert!(intersect(&prepared, None, &short, &cfg, &mut s).is_none());
     let late = Ray {
         tmin: 0.5,
         tmax: 1.1,
         ..ray
     };
-    let h = intersect(&prepared, &late, &cfg, &mut s).unwrap();
+    let h = intersect(&prepared, None, &late, &cfg, &mut s).unwrap();
     assert!(h.t >= 0.5 && h.t <= 1.1);
     let extent = full.hit_box.l1_diameter() + h.hit_box.l1_diameter();
     assert!((h.t - full.t).abs() * ray.dir.length() <= extent);

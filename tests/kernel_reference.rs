@@ -38,7 +38,7 @@ fn f64_path_matches_the_closed_form_on_a_parallelogram() {
         let t = a.dot(b.cross(r)) / det;
         let margin = 1e-9;
         let inside = |x: f64| x > margin && x < 1.0 - margin;
-        let got = intersect_f64(&patch, o, d, 0.0, f64::INFINITY, &cfg);
+        let got = intersect_f64(&patch, o, d, 0.0, f64::INFINITY, &cfg, None);
         if !(inside(u) && inside(v)) {
             let outside = |x: f64| x < -margin || x > 1.0 + margin;
             if outside(u) || outside(v) {
@@ -92,11 +92,12 @@ fn f64_reference_handles_rays_in_a_box_face_plane() {
         (DVec3::new(0.0, 0.5, 5.0), DVec3::NEG_Z),
         (DVec3::new(0.3, 1.0, 5.0), DVec3::NEG_Z),
     ] {
-        let h = intersect_f64(&patch, o, d, 0.0, f64::INFINITY, &cfg).expect("hit");
+        let h = intersect_f64(&patch, o, d, 0.0, f64::INFINITY, &cfg, None).expect("hit");
         assert!((h.t - 5.0).abs() < 1e-12, "t = {}", h.t);
         let mut stats = Default::default();
         let ray = patchtrace::geom::Ray::new(o.as_vec3(), d.as_vec3());
-        let h = intersect(&PreparedPatch::new(&patch), &ray, &cfg, &mut stats).expect("f32 hit");
+        let h =
+            intersect(&PreparedPatch::new(&patch), None, &ray, &cfg, &mut stats).expect("f32 hit");
         assert!((h.t - 5.0).abs() < 1e-5, "t = {}", h.t);
     }
 }

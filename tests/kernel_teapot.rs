@@ -33,7 +33,7 @@ fn nearest(prepared: &[PreparedPatch], ray: &Ray) -> Option<(usize, PatchHit)> {
     let mut ray = *ray;
     let mut best = None;
     for (k, p) in prepared.iter().enumerate() {
-        if let Some(h) = intersect(p, &ray, &cfg, &mut stats) {
+        if let Some(h) = intersect(p, None, &ray, &cfg, &mut stats) {
             ray.tmax = h.t;
             best = Some((k, h));
         }
@@ -191,7 +191,7 @@ fn secondary_rays_do_not_hit_their_own_patch_at_their_origin() {
                     let o = secondary_origin(&leave, n, outside, DEFAULT_ULPS);
                     let sec = Ray::new(o, d);
                     checked += 1;
-                    if let Some(s) = intersect(&prepared[k], &sec, &cfg, &mut stats)
+                    if let Some(s) = intersect(&prepared[k], None, &sec, &cfg, &mut stats)
                         && overlaps(&s.hit_box, &h.hit_box)
                     {
                         self_hits.push((scale, offset, outside, h, s));
@@ -200,8 +200,8 @@ fn secondary_rays_do_not_hit_their_own_patch_at_their_origin() {
                     // diameters? It must not.
                     let reach = 4.0 * h.hit_box.l1_diameter().max(f32::MIN_POSITIVE) / d.length();
                     let shadow = Ray { tmax: reach, ..sec };
-                    if outside && occluded(&prepared[k], &shadow, &cfg, &mut stats) {
-                        let s = intersect(&prepared[k], &shadow, &cfg, &mut stats).unwrap();
+                    if outside && occluded(&prepared[k], None, &shadow, &cfg, &mut stats) {
+                        let s = intersect(&prepared[k], None, &shadow, &cfg, &mut stats).unwrap();
                         if overlaps(&s.hit_box, &h.hit_box) {
                             self_hits.push((scale, offset, outside, h, s));
                         }

@@ -38,7 +38,7 @@ fn leaving(patch: &BezierPatch, x: f64, y: f64, dir: impl Fn(DVec3) -> DVec3) ->
         glam::Vec3::new(0.0, 0.0, -1.0),
     );
     let cfg = TothConfig::default();
-    let hit = toth::intersect(patch, &down, &cfg, false, &mut KernelStats::default())
+    let hit = toth::intersect(patch, None, &down, &cfg, false, &mut KernelStats::default())
         .expect("the primary ray hits the floor");
     let n = patch.normal(hit.u as f64, hit.v as f64);
     let o = secondary_origin(&hit.hit_box, n.as_vec3(), true, DEFAULT_ULPS);
@@ -69,6 +69,7 @@ fn agree(patch: &BezierPatch, ray: &Ray, mut kernel: impl FnMut(bool) -> Option<
         0.0,
         f64::INFINITY,
         &SubdivisionConfig::default(),
+        None,
     );
     match (fast, reference) {
         (Some(a), Some(r)) => assert!((a.t as f64 - r.t).abs() * d.length() <= HIT_DISTANCE),
@@ -100,10 +101,24 @@ fn random_rays(seed: u64, rays: usize) -> ([[KernelStats; 2]; 2], u32, u32) {
             if d.dot(n) > 0.05 { d } else { n }
         });
         let hit = agree(&patch, &ray, |on| {
-            toth::intersect(&patch, &ray, &toth_cfg, on, &mut stats[0][!on as usize])
+            toth::intersect(
+                &patch,
+                None,
+                &ray,
+                &toth_cfg,
+                on,
+                &mut stats[0][!on as usize],
+            )
         });
         agree(&patch, &ray, |on| {
-            cached::intersect(&patch, &ray, &cached_cfg, on, &mut stats[1][!on as usize])
+            cached::intersect(
+                &patch,
+                None,
+                &ray,
+                &cached_cfg,
+                on,
+                &mut stats[1][!on as usize],
+            )
         });
         if hit {
             again += 1;
@@ -166,7 +181,7 @@ fn tests_never_drop_a_root_after_the_ray_start() {
         );
         let ray = Ray::new(o.as_vec3(), (target - o).as_vec3());
         agree(&patch, &ray, |on| {
-            toth::intersect(&patch, &ray, &cfg, on, &mut s)
+            toth::intersect(&patch, None, &ray, &cfg, on, &mut s)
         });
     }
 }

@@ -1,4 +1,4 @@
-//! Parser robustness (issue 7): valid files of every text format, mutated (bytes flipped,
+//! Parser robustness (issue 7; IGES: issue 16): valid files of every text format, mutated (bytes flipped,
 //! lines dropped or repeated, numbers replaced by NaN, huge or empty values), never make a
 //! parser panic: each mutation gives a scene or an error with a location.
 //!
@@ -10,7 +10,9 @@ use std::path::{Path, PathBuf};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 
-use patchtrace::scene::{ParseError, bpt, obj, pbrt, rays, ron_format};
+use patchtrace::scene::{ParseError, bpt, iges, obj, pbrt, rays, ron_format, step};
+
+mod step_support;
 
 fn cases() -> u32 {
     std::env::var("PATCHTRACE_FUZZ_CASES")
@@ -135,7 +137,14 @@ fn located(e: &ParseError) -> bool {
 }
 
 fn fuzz<T>(ext: &str, parse: impl Fn(&Path, &str) -> Result<T, ParseError>) {
-    let files = samples(ext);
+    fuzz_files(ext, samples(ext), parse)
+}
+
+fn fuzz_files<T>(
+    ext: &str,
+    files: Vec<(PathBuf, String)>,
+    parse: impl Fn(&Path, &str) -> Result<T, ParseError>,
+) {
     assert!(!files.is_empty(), "no .{ext} samples in testdata/");
     let mut runner = TestRunner::new(Config {
         cases: cases(),
@@ -182,8 +191,21 @@ fn ron_parser_survives_mutations() {
 }
 
 #[test]
+fn iges_parser_survives_mutations() {
+    fuzz("igs", |p, s| iges::parse_iges(p, s).map(|_| ()));
+}
+
+#[test]
 fn ray_file_parser_survives_mutations() {
     fuzz("rays", rays::parse_rays);
+}
+
+/// The STEP sample is the test part (every face kind, pcurves, seams, units), written by
+/// the test writer rather than kept in testdata/.
+#[test]
+fn step_reader_survives_mutations() {
+    let files = vec![(PathBuf::from("bracket.step"), step_support::bracket(1))];
+    fuzz_files("step", files, step::read_step_str);
 }
 
 #[test]

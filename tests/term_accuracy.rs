@@ -114,7 +114,7 @@ fn depth_hit(prepared: &PreparedPatch, ray: &Ray, d: u8) -> Option<patchtrace::k
         termination: Termination::Depth(d),
         ..SubdivisionConfig::default()
     };
-    intersect(prepared, ray, &cfg, &mut KernelStats::default())
+    intersect(prepared, None, ray, &cfg, &mut KernelStats::default())
 }
 
 fn f32_ray(q: &RayQuery) -> Ray {
@@ -139,7 +139,7 @@ fn fixed_depth_error_falls_as_the_depth_grows() {
     for q in &rays {
         let ray = f32_ray(q);
         let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
-        let Some(reference) = intersect_f64(&patch, o, d, 0.0, f64::INFINITY, &cfg) else {
+        let Some(reference) = intersect_f64(&patch, o, d, 0.0, f64::INFINITY, &cfg, None) else {
             continue;
         };
         let p_ref = o + d * reference.t;
@@ -206,7 +206,7 @@ fn a_depth_8_hit_is_a_depth_8_cell_whose_box_holds_the_surface_there() {
             "S({u}, {v}) = {p} outside {lo}..{hi}"
         );
         // And the box is entered no later than the exact surface is reached.
-        if let Some(r) = intersect_f64(&patch, o, d, 0.0, f64::INFINITY, &cfg) {
+        if let Some(r) = intersect_f64(&patch, o, d, 0.0, f64::INFINITY, &cfg, None) {
             assert!(
                 h.t as f64 <= r.t * (1.0 + 4.0 * f64::from(f32::EPSILON)),
                 "entered at {} after the surface at {}",

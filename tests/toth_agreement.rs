@@ -16,7 +16,7 @@ fn toth_agrees_with_the_f64_reference_on_random_patches() {
     let cfg = TothConfig::default();
     let mut stats = KernelStats::default();
     let a = agrees_with_reference(6, 40, |patch, ray| {
-        intersect(patch, ray, &cfg, false, &mut stats)
+        intersect(patch, None, ray, &cfg, false, &mut stats)
     });
     assert!(
         a.hits > 600 && a.misses > 300,
@@ -45,12 +45,13 @@ fn isrt_shadow_answers_match_full_shadow_tests() {
             let (mut ray, o, d) = random_ray(&mut rng);
             // A segment that ends somewhere along the ray, as towards a light.
             ray.tmax = rng.range(0.3, 1.3) as f32;
-            let a = occluded(&patch, &ray, &full, false, &mut s_full);
-            let b = occluded(&patch, &ray, &isrt, false, &mut s_isrt);
+            let a = occluded(&patch, None, &ray, &full, false, &mut s_full);
+            let b = occluded(&patch, None, &ray, &isrt, false, &mut s_isrt);
             if a != b {
                 // Only a root within f32 precision of the segment's end may differ.
                 let h = intersect(
                     &patch,
+                    None,
                     &Ray {
                         tmax: f32::INFINITY,
                         ..ray

@@ -12,6 +12,7 @@ use glam::{DVec3, Vec3};
 
 use super::bvh::{Bvh, GeometryHasher};
 use super::grid::Grid;
+use crate::geom::trim::PatchTrim;
 use crate::geom::{Aabb, BezierPatch, DAabb, Ray};
 use crate::kernel::cached::{self, CachedConfig};
 use crate::kernel::subdivision::{self, PreparedPatch, SubdivisionConfig};
@@ -187,7 +188,28 @@ impl LeafPacks {
 /// The nearest candidate found so far during traversal.
 enum Candidate {
     Patch(u32, PatchHit),
+    /// A hit of the `f32` subdivision kernel, whose world hit box is made only for the
+    /// nearest ([`subdivision::KernelHit`]).
+    Subdivision(u32, subdivision::KernelHit),
     Triangle(u32, TriangleHit),
+}
+
+/// The ray as the `f32` subdivision kernel takes it, made at the first patch test of a
+/// query (most rays that miss never reach one) and shared by every patch it meets.
+struct PatchRay<'a> {
+    ray: &'a Ray,
+    kernel: Option<subdivision::KernelRay>,
+}
+
+impl<'a> PatchRay<'a> {
+    fn new(ray: &'a Ray) -> Self {
+        PatchRay { ray, kernel: None }
+    }
+
+    fn kernel(&mut self, cfg: &SubdivisionConfig) -> &subdivision::KernelRay {
+        self.kernel
+            .get_or_insert_with(|| subdivision::KernelRay::new(self.ray, cfg))
+    }
 }
 
 /// The acceleration structure over the primitives.
@@ -210,6 +232,8 @@ pub struct SceneGeometry {
     originals: Vec<BezierPatch>,
     /// (object, patch within object) per patch.
     ids: Vec<(u32, u32)>,
+    /// Per patch, its trim where its loops cut it.
+    trims: Vec<Option<Box<PatchTrim>>>,
     triangles: Triangles,
     accel: Accel,
 }
@@ -217,11 +241,13 @@ pub struct SceneGeometry {
 impl SceneGeometry {
     /// Prepares the patches and builds the BVH.
     pub fn build(scene: &Scene) -> SceneGeometry {
-        let (originals, ids) = collect_patches(scene);
+        let patches = collect_patches(scene);
         let triangles = collect_triangles(scene);
-        let boxes: Vec<Aabb> = originals
+        let boxes: Vec<Aabb> = patches
+            .originals
             .iter()
-            .map(|p| p.tight_box().to_f32_outward())
+            .zip(&patches.trims)
+            .map(|(p, trim)| surviving_box(p, trim.as_deref()).to_f32_outward())
             .chain(
                 triangles
                     .corners
@@ -229,33 +255,27 @@ impl SceneGeometry {
                     .map(|c| c.iter().copied().collect()),
             )
             .collect();
-        let bvh = Bvh::build_packed(&boxes, originals.len());
-        {
-            let accel = Accel::bvh(bvh, originals.len(), &triangles);
-            Self::with_accel(originals, ids, triangles, accel)
-        }
+        let bvh = Bvh::build_packed(&boxes, patches.originals.len());
+        let accel = Accel::bvh(bvh, patches.originals.len(), &triangles);
+        Self::with_accel(patches, triangles, accel)
     }
 
     /// Prepares the patches and builds the uniform grid of LG90 §3.1 within `budget_bytes`
     /// (see [`Grid::build`]).
     pub fn build_grid(scene: &Scene, budget_bytes: usize) -> SceneGeometry {
-        let (originals, ids) = collect_patches(scene);
+        let patches = collect_patches(scene);
         let triangles = collect_triangles(scene);
-        let grid = Grid::build(&originals, &triangles.corners, budget_bytes);
-        Self::with_accel(originals, ids, triangles, Accel::Grid(grid))
+        let grid = Grid::build(&patches.originals, &triangles.corners, budget_bytes);
+        Self::with_accel(patches, triangles, Accel::Grid(grid))
     }
 
-    fn with_accel(
-        originals: Vec<BezierPatch>,
-        ids: Vec<(u32, u32)>,
-        triangles: Triangles,
-        accel: Accel,
-    ) -> SceneGeometry {
-        let prepared = originals.iter().map(PreparedPatch::new).collect();
+    fn with_accel(patches: Patches, triangles: Triangles, accel: Accel) -> SceneGeometry {
+        let prepared = patches.originals.iter().map(PreparedPatch::new).collect();
         SceneGeometry {
             prepared,
-            originals,
-            ids,
+            originals: patches.originals,
+            ids: patches.ids,
+            trims: patches.trims,
             triangles,
             accel,
         }
@@ -322,13 +342,25 @@ impl SceneGeometry {
         precision: &Precision,
         stats: &mut QueryStats,
     ) -> Option<SceneHit> {
+        let mut patch_ray = PatchRay::new(ray);
         let best = match &self.accel {
-            Accel::Bvh(bvh, packs) => self.nearest_in_bvh(bvh, packs, ray, precision, stats),
-            Accel::Grid(grid) => self.nearest_in_grid(grid, ray, precision, stats),
+            Accel::Bvh(bvh, packs) => {
+                self.nearest_in_bvh(bvh, packs, &mut patch_ray, precision, stats)
+            }
+            Accel::Grid(grid) => self.nearest_in_grid(grid, &mut patch_ray, precision, stats),
         };
         Some(match best? {
             Candidate::Patch(prim, h) => {
                 self.finish_patch_hit(prim, h.t as f64, h.u as f64, h.v as f64, h.hit_box)
+            }
+            Candidate::Subdivision(prim, h) => {
+                // The test that found `h` made the kernel ray.
+                let hit_box = patch_ray
+                    .kernel
+                    .as_ref()
+                    .map_or(Aabb::EMPTY, |k| k.hit_box(&h));
+                let (u, v) = h.uv();
+                self.finish_patch_hit(prim, h.t() as f64, u, v, hit_box)
             }
             Candidate::Triangle(k, h) => self.finish_triangle_hit(k, &h),
         })
@@ -361,7 +393,9 @@ impl SceneGeometry {
                 continue;
             }
             stats.kernel.patch_tests += 1;
-            if let Some(h) = subdivision::intersect_f64(patch, origin, dir, tmin, limit, cfg) {
+            let trim = self.trim(prim as u32);
+            if let Some(h) = subdivision::intersect_f64(patch, origin, dir, tmin, limit, cfg, trim)
+            {
                 best = Some((prim as u32, h));
             }
         }
@@ -405,10 +439,11 @@ impl SceneGeometry {
         &self,
         bvh: &Bvh,
         packs: &LeafPacks,
-        ray: &Ray,
+        patch_ray: &mut PatchRay,
         precision: &Precision,
         stats: &mut QueryStats,
     ) -> Option<Candidate> {
+        let ray = patch_ray.ray;
         let mut best = None;
         // The kernel counters borrowed apart from the traversal counters the closure leaves.
         let kernel = &mut stats.kernel;
@@ -423,13 +458,11 @@ impl SceneGeometry {
                     if prim >= patches {
                         continue;
                     }
-                    let r = Ray {
-                        tmax: *tmax,
-                        ..*ray
-                    };
-                    if let Some(hit) = self.patch_hit(prim, &r, precision, kernel) {
-                        *tmax = tmax.min(hit.t);
-                        best = Some(Candidate::Patch(prim, hit));
+                    if let Some((t, hit)) =
+                        self.patch_hit(prim, patch_ray, *tmax, precision, kernel)
+                    {
+                        *tmax = tmax.min(t);
+                        best = Some(hit);
                     }
                 }
             }
@@ -465,17 +498,17 @@ impl SceneGeometry {
         let shear = PackShear::new(&RayShear::new(ray));
         let patches = self.prepared.len() as u32;
         let kernel = &mut stats.kernel;
+        let mut patch_ray = PatchRay::new(ray);
         let mut hit = false;
         let mut surface_tests = 0;
         let t = bvh.traverse_leaves(ray, |range, _| {
             surface_tests += range.len() as u64;
-            hit = bvh.prim_indices()[range.clone()]
-                .iter()
-                .any(|&prim| prim < patches && self.patch_occluded(prim, ray, precision, kernel))
-                || packs.of_leaf(&range).1.iter().any(|pack| {
-                    kernel.patch_tests += 1;
-                    intersect_pack(&shear, pack, ray.tmin, ray.tmax).mask != 0
-                });
+            hit = bvh.prim_indices()[range.clone()].iter().any(|&prim| {
+                prim < patches && self.patch_occluded(prim, &mut patch_ray, precision, kernel)
+            }) || packs.of_leaf(&range).1.iter().any(|pack| {
+                kernel.patch_tests += 1;
+                intersect_pack(&shear, pack, ray.tmin, ray.tmax).mask != 0
+            });
             if hit {
                 ControlFlow::Break(())
             } else {
@@ -492,10 +525,11 @@ impl SceneGeometry {
     fn nearest_in_grid(
         &self,
         grid: &Grid,
-        ray: &Ray,
+        patch_ray: &mut PatchRay,
         precision: &Precision,
         stats: &mut QueryStats,
     ) -> Option<Candidate> {
+        let ray = patch_ray.ray;
         let mut best = None;
         let kernel = &mut stats.kernel;
         let shear = RayShear::new(ray);
@@ -503,10 +537,9 @@ impl SceneGeometry {
         let g = grid.traverse(ray, |prim, tmax| {
             kernel.patch_tests += (prim >= patches) as u64;
             if prim < patches {
-                let r = Ray { tmax, ..*ray };
-                let hit = self.patch_hit(prim, &r, precision, kernel)?;
-                best = Some(Candidate::Patch(prim, hit));
-                Some(hit.t)
+                let (t, hit) = self.patch_hit(prim, patch_ray, tmax, precision, kernel)?;
+                best = Some(hit);
+                Some(t)
             } else {
                 let k = prim - patches;
                 let [a, b, c] = self.triangles.corners[k as usize];
@@ -532,9 +565,10 @@ impl SceneGeometry {
         let shear = RayShear::new(ray);
         let patches = self.prepared.len() as u32;
         let kernel = &mut stats.kernel;
+        let mut patch_ray = PatchRay::new(ray);
         let (hit, g) = grid.traverse_any(ray, |prim| {
             if prim < patches {
-                self.patch_occluded(prim, ray, precision, kernel)
+                self.patch_occluded(prim, &mut patch_ray, precision, kernel)
             } else {
                 kernel.patch_tests += 1;
                 let [a, b, c] = self.triangles.corners[(prim - patches) as usize];
@@ -547,50 +581,65 @@ impl SceneGeometry {
         hit
     }
 
-    /// Nearest hit on patch `prim` by the `f32`-ray kernel `precision` selects.
+    /// Nearest hit on patch `prim` with `t` up to `tmax` by the `f32`-ray kernel
+    /// `precision` selects, and its `t`.
     fn patch_hit(
         &self,
         prim: u32,
-        ray: &Ray,
+        ray: &mut PatchRay,
+        tmax: f32,
         precision: &Precision,
         kernel: &mut KernelStats,
-    ) -> Option<PatchHit> {
+    ) -> Option<(f32, Candidate)> {
+        let patch_hit = |h: PatchHit| (h.t, Candidate::Patch(prim, h));
+        let r = Ray { tmax, ..*ray.ray };
+        let (patch, trim) = (&self.originals[prim as usize], self.trim(prim));
         match precision {
             Precision::Toth(cfg) => {
                 let origin = cfg.surface_of_origin == Some(prim);
-                toth::intersect(&self.originals[prim as usize], ray, cfg, origin, kernel)
+                toth::intersect(patch, trim, &r, cfg, origin, kernel).map(patch_hit)
             }
             Precision::Cached(cfg) => {
                 let origin = cfg.toth.surface_of_origin == Some(prim);
-                cached::intersect(&self.originals[prim as usize], ray, cfg, origin, kernel)
+                cached::intersect(patch, trim, &r, cfg, origin, kernel).map(patch_hit)
             }
             Precision::F32(cfg) | Precision::F64(cfg) => {
-                subdivision::intersect(&self.prepared[prim as usize], ray, cfg, kernel)
+                let prepared = &self.prepared[prim as usize];
+                subdivision::nearest(prepared, trim, ray.kernel(cfg), tmax, cfg, kernel)
+                    .map(|h| (h.t(), Candidate::Subdivision(prim, h)))
             }
         }
     }
 
-    /// Whether patch `prim` blocks `ray`, by the kernel `precision` selects.
+    /// Whether patch `prim` blocks the ray, by the kernel `precision` selects.
     fn patch_occluded(
         &self,
         prim: u32,
-        ray: &Ray,
+        ray: &mut PatchRay,
         precision: &Precision,
         kernel: &mut KernelStats,
     ) -> bool {
+        let (patch, trim) = (&self.originals[prim as usize], self.trim(prim));
         match precision {
             Precision::Toth(cfg) => {
                 let origin = cfg.surface_of_origin == Some(prim);
-                toth::occluded(&self.originals[prim as usize], ray, cfg, origin, kernel)
+                toth::occluded(patch, trim, ray.ray, cfg, origin, kernel)
             }
             Precision::Cached(cfg) => {
                 let origin = cfg.toth.surface_of_origin == Some(prim);
-                cached::occluded(&self.originals[prim as usize], ray, cfg, origin, kernel)
+                cached::occluded(patch, trim, ray.ray, cfg, origin, kernel)
             }
             Precision::F32(cfg) | Precision::F64(cfg) => {
-                subdivision::occluded(&self.prepared[prim as usize], ray, cfg, kernel)
+                let prepared = &self.prepared[prim as usize];
+                subdivision::blocks(prepared, trim, ray.kernel(cfg), cfg, kernel)
             }
         }
+    }
+
+    /// Patch `prim`'s trim, `None` where its loops do not cut it.
+    #[inline]
+    fn trim(&self, prim: u32) -> Option<&PatchTrim> {
+        self.trims[prim as usize].as_deref()
     }
 
     fn finish_patch_hit(&self, prim: u32, t: f64, u: f64, v: f64, hit_box: Aabb) -> SceneHit {
@@ -644,23 +693,38 @@ impl SceneGeometry {
     }
 }
 
-/// All Bézier patches of the scene in contract order, with their (object, patch) ids.
-/// Patches collapsed to a curve or a point are left out: they have no area, so no ray hits
-/// them exactly, while rounding would let the `f32` kernel report hits on them whose
-/// secondary rays, lacking a normal to leave along, re-hit the same curve (issue 7).
-fn collect_patches(scene: &Scene) -> (Vec<BezierPatch>, Vec<(u32, u32)>) {
-    let mut patches = Vec::new();
-    let mut ids = Vec::new();
+/// The scene's patches as the accelerator indexes them.
+struct Patches {
+    originals: Vec<BezierPatch>,
+    /// (object, patch within object) per patch.
+    ids: Vec<(u32, u32)>,
+    /// Per patch, its trim where its loops cut it (Dammertz §2.6).
+    trims: Vec<Option<Box<PatchTrim>>>,
+}
+
+/// All Bézier patches of the scene in contract order, with their (object, patch) ids and
+/// trims. Patches collapsed to a curve or a point are left out: they have no area, so no
+/// ray hits them exactly, while rounding would let the `f32` kernel report hits on them
+/// whose secondary rays, lacking a normal to leave along, re-hit the same curve (issue 7).
+/// So are patches their trim loops cut away wholly (culling, issue 15).
+fn collect_patches(scene: &Scene) -> Patches {
+    let mut out = Patches {
+        originals: Vec::new(),
+        ids: Vec::new(),
+        trims: Vec::new(),
+    };
     for (o, object) in scene.objects.iter().enumerate() {
-        for (k, p) in object.bezier_patches().into_iter().enumerate() {
+        for (k, entry) in object.trimmed_patches().into_iter().enumerate() {
+            let Some((p, trim)) = entry else { continue };
             if p.has_zero_area() {
                 continue;
             }
-            patches.push(p);
-            ids.push((o as u32, k as u32));
+            out.originals.push(p);
+            out.ids.push((o as u32, k as u32));
+            out.trims.push(trim);
         }
     }
-    (patches, ids)
+    out
 }
 
 impl SceneGeometry {
@@ -673,20 +737,18 @@ impl SceneGeometry {
         use crate::scene::LoadError;
         let file = std::fs::File::open(path).map_err(|e| LoadError::io(path, e))?;
         let mut reader = std::io::BufReader::new(file);
-        let (originals, ids) = collect_patches(scene);
+        let patches = collect_patches(scene);
         let triangles = collect_triangles(scene);
-        let bvh = Bvh::read(&mut reader, hash_geometry(&originals, &triangles))
+        let bvh = Bvh::read(&mut reader, hash_geometry(&patches.originals, &triangles))
             .map_err(|e| LoadError::invalid(path, e.to_string()))?;
-        if bvh.prim_count() != originals.len() + triangles.corners.len() {
+        if bvh.prim_count() != patches.originals.len() + triangles.corners.len() {
             return Err(LoadError::invalid(
                 path,
                 "the BVH indexes a different number of patches than the scene; rebuild it with `patchtrace bvh`",
             ));
         }
-        Ok({
-            let accel = Accel::bvh(bvh, originals.len(), &triangles);
-            Self::with_accel(originals, ids, triangles, accel)
-        })
+        let accel = Accel::bvh(bvh, patches.originals.len(), &triangles);
+        Ok(Self::with_accel(patches, triangles, accel))
     }
 
     /// Writes the BVH with the scene's geometry hash, atomically; refused for a grid.
@@ -723,6 +785,37 @@ fn hash_geometry(patches: &[BezierPatch], triangles: &Triangles) -> u64 {
         }
     }
     h.finish()
+}
+
+/// Quarterings of a trimmed patch when bounding the part its loops keep: 4 × 4 pieces.
+const SURVIVING_BOX_LEVELS: u32 = 2;
+
+/// The BVH box of a patch: its tight box, or for a patch its trim loops cut, the union of
+/// the tight boxes of those of its 4 × 4 sub-patches (de Casteljau halvings) that keep any
+/// of the surface ([`PatchTrim::keeps_any_of`]). A plate mostly cut away then no longer
+/// sends every ray through its whole rectangle to the kernel; 16 sub-patches per cut patch
+/// at load is cheap. The kernel still starts from the whole patch.
+fn surviving_box(p: &BezierPatch, trim: Option<&PatchTrim>) -> DAabb {
+    let Some(trim) = trim else {
+        return p.tight_box();
+    };
+    let mut parts = vec![p.clone()];
+    for _ in 0..SURVIVING_BOX_LEVELS {
+        parts = parts
+            .iter()
+            .flat_map(|q| {
+                let (a, b) = q.split_u();
+                let (a0, a1) = a.split_v();
+                let (b0, b1) = b.split_v();
+                [a0, a1, b0, b1]
+            })
+            .collect();
+    }
+    let kept = parts
+        .iter()
+        .filter(|q| trim.keeps_any_of(q.domain()))
+        .fold(DAabb::EMPTY, |acc, q| acc.union(&q.tight_box()));
+    if kept.is_empty() { p.tight_box() } else { kept }
 }
 
 /// All mesh triangles of the scene in object order, rounded to `f32`.

@@ -27,7 +27,8 @@ pub enum Command {
     Render(RenderArgs),
     /// Nearest hit per ray from a ray file, as CSV.
     Trace(TraceArgs),
-    /// Tessellate free-form surfaces into a triangle mesh (OBJ, glTF or GLB).
+    /// Tessellate free-form surfaces into a triangle mesh (OBJ, glTF or GLB); trimmed ones
+    /// in their parameter domain, with the gaps between trimmed faces reported.
     Tessellate(TessellateArgs),
     /// Compare two images (PNG or EXR): RMSE, PSNR, MAE, max error, FLIP, coverage.
     Diff(DiffArgs),
@@ -149,7 +150,9 @@ pub struct TeapotsArgs {
 
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// Scene (.ron) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb).
+    /// Scene (.ron) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb, .igs, .iges, .step,
+    /// .stp). For IGES and STEP files also the units, what was not read (by type),
+    /// surfaces not converted, and the largest error of projected trim curves.
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
@@ -160,12 +163,12 @@ pub struct InfoArgs {
 
 #[derive(Debug, Args)]
 pub struct ImportArgs {
-    /// Input scene or geometry file.
+    /// Input scene or geometry file (any SCENE input, IGES and STEP included).
     pub input: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
-    /// Output: .ron (scene, geometry inline), .bpt (non-rational patches) or .obj
-    /// (free-form Bézier patches).
+    /// Output: .ron (scene, geometry inline, NURBS with their trim loops), .bpt
+    /// (non-rational patches) or .obj (free-form Bézier patches).
     #[arg(short, long)]
     pub output: PathBuf,
 }
@@ -316,6 +319,10 @@ pub struct KernelArgs {
     /// `--kernel cached`.
     #[arg(long, value_name = "LEVELS")]
     pub cache_depth: Option<u8>,
+    /// Render the surfaces untrimmed: read trim loops and drop them, to see what trimming
+    /// removes (the effect line says "trims ignored").
+    #[arg(long)]
+    pub ignore_trims: bool,
     /// Load the BVH from this file (written by `patchtrace bvh`) instead of building it.
     #[arg(long, value_name = "FILE")]
     pub bvh: Option<PathBuf>,
@@ -348,8 +355,10 @@ pub struct RenderArgs {
     pub output: PathBuf,
     #[command(flatten)]
     pub kernel: KernelArgs,
-    /// Ulps by which secondary ray origins are moved off the hit box (Dammertz §2.4.2).
-    #[arg(long, default_value_t = crate::kernel::secondary::DEFAULT_ULPS)]
+    /// Ulps by which secondary ray origins are moved off the hit box (Dammertz §2.4.2),
+    /// at most 4096.
+    #[arg(long, default_value_t = crate::kernel::secondary::DEFAULT_ULPS,
+          value_parser = clap::value_parser!(u32).range(0..=i64::from(crate::kernel::secondary::MAX_ULPS)))]
     pub ulps: u32,
     #[command(flatten)]
     pub size: ImageSizeArgs,
@@ -477,6 +486,9 @@ pub struct TessellateArgs {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+    /// No progress bar.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 fn parse_grid(s: &str) -> Result<(u32, u32), String> {
@@ -588,29 +600,33 @@ pub struct ImageSizeArgs {
     /// object `up: Y` instead.
     #[arg(long, value_enum)]
     pub up: Option<crate::scene::model::Axis>,
-    /// Override the camera's image width.
-    #[arg(long)]
+    /// Override the camera's image width (1 to 32768; a render holds at most 2^26 pixels).
+    #[arg(long, value_parser = image_edge())]
     pub width: Option<u32>,
-    /// Override the camera's image height.
-    #[arg(long)]
+    /// Override the camera's image height (1 to 32768; a render holds at most 2^26 pixels).
+    #[arg(long, value_parser = image_edge())]
     pub height: Option<u32>,
 }
 
+fn image_edge() -> clap::builder::RangedI64ValueParser<u32> {
+    clap::value_parser!(u32).range(1..=i64::from(crate::scene::MAX_IMAGE_EDGE))
+}
+
 impl ImageSizeArgs {
-    /// Applies the overrides to the scene read from `path`, refusing a zero size; bare
-    /// geometry is framed again for the new size and `--up`.
+    /// Applies the overrides to the scene read from `path`, refusing an edge beyond
+    /// [`MAX_IMAGE_EDGE`](crate::scene::MAX_IMAGE_EDGE); bare geometry is framed again for
+    /// the new size and `--up`.
     pub fn apply(
         &self,
         path: &std::path::Path,
         scene: &mut crate::scene::Scene,
     ) -> anyhow::Result<()> {
-        anyhow::ensure!(
-            self.width != Some(0) && self.height != Some(0),
-            "--width and --height must be at least 1"
-        );
         let camera = &mut scene.camera;
         camera.width = self.width.unwrap_or(camera.width);
         camera.height = self.height.unwrap_or(camera.height);
+        camera
+            .check_size()
+            .map_err(|e| crate::cli::BadArgument(format!("--width/--height: {e}")))?;
         crate::scene::load::reframe(path, scene, self.up)?;
         Ok(())
     }

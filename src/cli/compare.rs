@@ -37,6 +37,8 @@ struct Row {
     psnr: f64,
     flip_mean: f64,
     silhouette_pixels: u64,
+    /// The largest gap between trimmed faces (tessellations only).
+    trim_gap: Option<f64>,
 }
 
 /// Builds the accelerator and renders, timing both.
@@ -63,6 +65,8 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     let pool = thread_pool(args.threads)?;
     let mut scene = load_scene_with(&args.scene, args.mesh.load_options())?;
     args.size.apply(&args.scene, &mut scene)?;
+    crate::scene::check_film_pixels(scene.camera.width, scene.camera.height)
+        .map_err(crate::cli::BadArgument)?;
     std::fs::create_dir_all(&args.out_dir)
         .with_context(|| format!("creating {}", args.out_dir.display()))?;
     if !args.quiet {
@@ -82,6 +86,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
         psnr: f64::INFINITY,
         flip_mean: 0.0,
         silhouette_pixels: 0,
+        trim_gap: None,
     }];
 
     for &n in &args.triangles {
@@ -104,6 +109,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
             psnr: d.psnr,
             flip_mean: d.flip.mean,
             silhouette_pixels: d.coverage_mismatch.unwrap_or(0),
+            trim_gap: (report.trim_gaps.faces > 0).then_some(report.trim_gaps.largest),
         });
     }
 
@@ -128,7 +134,7 @@ fn write_text(path: &Path, text: &str) -> anyhow::Result<()> {
     Ok(())
 }
 
-const COLUMNS: [&str; 9] = [
+const COLUMNS: [&str; 10] = [
     "method",
     "triangles",
     "memory (bytes)",
@@ -138,9 +144,10 @@ const COLUMNS: [&str; 9] = [
     "PSNR (dB)",
     "FLIP mean",
     "silhouette pixels",
+    "trim gap",
 ];
 
-fn cells(r: &Row) -> [String; 9] {
+fn cells(r: &Row) -> [String; 10] {
     [
         r.method.clone(),
         r.triangles.to_string(),
@@ -155,6 +162,7 @@ fn cells(r: &Row) -> [String; 9] {
         },
         format!("{:.5}", r.flip_mean),
         r.silhouette_pixels.to_string(),
+        r.trim_gap.map_or("-".into(), |g| format!("{g:.3e}")),
     ]
 }
 

@@ -4,11 +4,11 @@ use std::io::Write;
 use std::process::ExitCode;
 
 use crate::cli::args::InfoArgs;
-use crate::scene::load_scene_with;
+use crate::scene::load::{InputKind, load_scene_noted};
 use crate::scene::summary::summarize;
 
 pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
-    let scene = load_scene_with(&args.scene, args.mesh.load_options())?;
+    let (scene, notes) = load_scene_noted(&args.scene, args.mesh.load_options())?;
     let s = summarize(&scene);
     let mut out = std::io::stdout().lock();
     if args.json {
@@ -37,6 +37,33 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
             "  {}: material \"{}\", {} surface(s), {} NURBS, {} patch(es), {} trim loop(s), {} triangle(s)",
             o.name, o.material, o.surfaces, o.nurbs_surfaces, o.patches, o.trim_loops, o.triangles
         )?;
+        for t in &o.trimmed_surfaces {
+            writeln!(
+                out,
+                "    surface {}: {} trim loop(s) ({} hole(s)), {} curve(s) as {} Bézier piece(s); patches: {} cut, {} whole, {} cut away",
+                t.surface,
+                t.loops,
+                t.holes,
+                t.curves,
+                t.pieces,
+                t.patches_cut,
+                t.patches_whole,
+                t.patches_culled
+            )?;
+        }
+        if let Some(sd) = &o.subdivision {
+            writeln!(
+                out,
+                "    Catmull–Clark cage: {} vertices, {} faces -> {} quads; {} regular patches, {} extraordinary ends, {} T-junctions, {} levels",
+                sd.cage_vertices,
+                sd.cage_faces,
+                sd.quads,
+                sd.regular_patches,
+                sd.extraordinary_ends,
+                sd.t_junctions,
+                sd.levels
+            )?;
+        }
     }
     let degrees: Vec<String> = s.degrees.iter().map(|(d, n)| format!("{d}: {n}")).collect();
     writeln!(
@@ -60,5 +87,13 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
         }
     )?;
     writeln!(out, "max depth: {}", s.max_depth)?;
+    for note in notes {
+        writeln!(out, "{note}")?;
+    }
+    if InputKind::of(&args.scene) == Some(InputKind::Iges) {
+        for line in crate::scene::iges::read_iges(&args.scene)?.report.lines() {
+            writeln!(out, "{line}")?;
+        }
+    }
     Ok(ExitCode::SUCCESS)
 }

@@ -33,6 +33,12 @@ pub const EXIT_BAD_INPUT: u8 = 2;
 /// Exit status for any other failure.
 pub const EXIT_FAILURE: u8 = 1;
 
+/// A flag value the command cannot honour (a limit or budget exceeded): bad input, exit 2
+/// like clap's own argument errors.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct BadArgument(pub String);
+
 /// Parses the command line, runs the command and prints any error.
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
@@ -81,6 +87,10 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
 fn exit_code_for(err: &anyhow::Error) -> u8 {
     if err.downcast_ref::<crate::scene::LoadError>().is_some()
         || err.downcast_ref::<crate::scene::ParseError>().is_some()
+        || err.downcast_ref::<BadArgument>().is_some()
+        || err
+            .downcast_ref::<crate::tessellate::TessellateError>()
+            .is_some()
     {
         EXIT_BAD_INPUT
     } else {

@@ -129,7 +129,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     let pool = thread_pool(args.threads)?;
     let mut prepared = prepare(&args.scene, &args.mesh, &args.kernel)?;
     args.size.apply(&args.scene, &mut prepared.scene)?;
-    let plan = EffectPlan::for_scene(&prepared.scene);
+    let plan = EffectPlan {
+        trims: prepared.trims,
+        ..EffectPlan::for_scene(&prepared.scene)
+    };
     eprintln!("{plan}");
     let still = prepared.scene.camera.clone();
     for frame in frames {
@@ -183,6 +186,8 @@ fn render_frame(
         (None, Some(tile)) => Window::tile(tile, width, height).map_err(anyhow::Error::msg)?,
         (None, None) => Window::full(width, height),
     };
+    crate::scene::check_film_pixels(window.width(), window.height())
+        .map_err(crate::cli::BadArgument)?;
     let aovs = aov::expand(&args.aov);
     let job = RenderJob {
         order: args.order,

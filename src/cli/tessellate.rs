@@ -9,7 +9,7 @@ use serde::Serialize;
 use crate::cli::args::TessellateArgs;
 use crate::scene::{LoadError, load_scene_with};
 use crate::tessellate::{
-    MeshFormat, TessellationMode, TessellationReport, tessellate_scene, write_mesh_scene,
+    MeshFormat, TessellationMode, TessellationReport, tessellate_scene_with, write_mesh_scene,
 };
 
 /// Triangles per patch when no mode is given: Dammertz's coarsest table row.
@@ -48,7 +48,10 @@ pub fn run(args: TessellateArgs) -> anyhow::Result<ExitCode> {
     }
     let scene = load_scene_with(&args.scene, args.mesh.load_options())?;
     let start = Instant::now();
-    let (meshes, report) = tessellate_scene(&scene, mode(&args))?;
+    let bar = crate::render::renderer::progress_bar(args.quiet, "tessellating");
+    bar.set_length(scene.patch_count() as u64);
+    let (meshes, report) = tessellate_scene_with(&scene, mode(&args), &mut || bar.inc(1))?;
+    bar.finish_and_clear();
     let seconds = start.elapsed().as_secs_f64();
     let file_bytes = write_mesh_scene(&args.output, &meshes)?;
     let r = Report {
@@ -74,6 +77,14 @@ pub fn run(args: TessellateArgs) -> anyhow::Result<ExitCode> {
             args.output.display()
         )?;
         writeln!(out, "time:      {:.3} s", r.seconds)?;
+        let g = &r.mesh.trim_gaps;
+        if g.faces > 0 {
+            writeln!(
+                out,
+                "trim gaps: largest {:.3e} between {} trimmed faces; {} of {} shared boundary samples open wider than f32 rounding; {} samples with no other face within {:.3e} (free edges)",
+                g.largest, g.faces, g.open_samples, g.shared_samples, g.free_samples, g.radius
+            )?;
+        }
     }
     Ok(ExitCode::SUCCESS)
 }

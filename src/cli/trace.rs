@@ -11,41 +11,65 @@ use crate::accel::scene::{Precision, QueryStats, SceneGeometry, SceneHit};
 use crate::cli::args::TraceArgs;
 use crate::cli::setup::{precision, prepare, thread_pool};
 use crate::geom::Ray;
-use crate::scene::Scene;
-use crate::scene::error::read_text;
-use crate::scene::rays::{RayQuery, parse_rays};
+use crate::scene::rays::{RayChunks, RayQuery};
 use crate::scene::write::write_atomic;
+use crate::scene::{LoadError, Scene};
 
 /// The header line of the contract.
 pub const TRACE_HEADER: &str = "ray,hit,t,object,patch,u,v,px,py,pz,nx,ny,nz";
 
+/// Rays traced per chunk: the file is read, traced and written a chunk at a time, in
+/// order, so memory stays at one chunk of rays and rows (a few MB) for any file size.
+/// 2^16 rays keep both workers of a small machine busy between chunk boundaries.
+pub const CHUNK_RAYS: usize = 1 << 16;
+
 pub fn run(args: TraceArgs) -> anyhow::Result<ExitCode> {
-    let src = read_text(&args.rays)?;
-    let rays = parse_rays(&args.rays, &src)?;
+    let file = std::fs::File::open(&args.rays).map_err(|e| LoadError::io(&args.rays, e))?;
+    let mut rays = RayChunks::new(&args.rays, std::io::BufReader::new(file));
     let prepared = prepare(&args.scene, &args.mesh, &args.kernel)?;
     let precision = precision(&args.kernel, &prepared.scene.camera)?;
     let pool = thread_pool(args.threads)?;
-    let rows: Vec<String> = pool.install(|| {
-        rays.par_iter()
-            .enumerate()
-            .map(|(i, q)| {
-                let hit = trace_one(&prepared.geometry, q, &precision)
-                    .map(|(h, o, d)| (in_contract_terms(&prepared.scene, h), o, d));
-                row(i, hit)
-            })
-            .collect()
-    });
-    let write = |w: &mut dyn Write| -> std::io::Result<()> {
+    // A bad line found mid-file stops the output; the error is kept here because the
+    // writer can only return an io::Error.
+    let mut failed: Option<LoadError> = None;
+    let mut write = |w: &mut dyn Write| -> std::io::Result<()> {
         writeln!(w, "{TRACE_HEADER}")?;
-        for r in &rows {
-            writeln!(w, "{r}")?;
+        let mut first = 0;
+        loop {
+            let chunk = match rays.next_chunk(CHUNK_RAYS) {
+                Ok(c) if c.is_empty() => break,
+                Ok(c) => c,
+                Err(e) => {
+                    failed = Some(e);
+                    return Err(std::io::Error::other("bad ray file"));
+                }
+            };
+            let rows: Vec<String> = pool.install(|| {
+                chunk
+                    .par_iter()
+                    .enumerate()
+                    .map(|(i, q)| {
+                        let hit = trace_one(&prepared.geometry, q, &precision)
+                            .map(|(h, o, d)| (in_contract_terms(&prepared.scene, h), o, d));
+                        row(first + i, hit)
+                    })
+                    .collect()
+            });
+            for r in &rows {
+                writeln!(w, "{r}")?;
+            }
+            first += chunk.len();
         }
         w.flush()
     };
-    match &args.output {
-        Some(path) => write_atomic(path, write)?,
-        None => write(&mut std::io::stdout().lock())?,
+    let result = match &args.output {
+        Some(path) => write_atomic(path, &mut write).map_err(anyhow::Error::from),
+        None => write(&mut std::io::stdout().lock()).map_err(anyhow::Error::from),
+    };
+    if let Some(e) = failed {
+        return Err(e.into());
     }
+    result?;
     Ok(ExitCode::SUCCESS)
 }
 

@@ -40,6 +40,8 @@ pub struct KernelStats {
     pub jumps: u64,
     /// Sub-patches a jump proved the ray does not cross, dropped without a split.
     pub jump_drops: u64,
+    /// Candidate hits tested against a patch's trim loops.
+    pub trim_tests: u64,
     /// The Toth kernel's own counters (LG90 Tables 2–6 rows).
     pub toth: toth::TothStats,
     /// The cached kernel's cache counters (LG90 Tables 2–6 rows).
@@ -53,6 +55,7 @@ impl KernelStats {
         self.box_tests += other.box_tests;
         self.jumps += other.jumps;
         self.jump_drops += other.jump_drops;
+        self.trim_tests += other.trim_tests;
         self.toth.add(&other.toth);
         self.cached.add(&other.cached);
     }

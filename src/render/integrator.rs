@@ -7,7 +7,7 @@
 
 use glam::{Vec3, Vec4};
 
-use super::plan::EffectPlan;
+use super::plan::{EffectPlan, MAX_TREE_RAYS};
 use super::stats::{RayKind, RayTally};
 use crate::accel::scene::{Precision, QueryStats, SceneGeometry};
 use crate::geom::Ray;
@@ -30,25 +30,72 @@ pub struct Integrator<'a> {
     pub settings: TraceSettings,
 }
 
+/// Where a ray sits in its primary ray's tree: path depth (primary = 1) and weight, the
+/// largest channel of the product of the coefficients its contribution is scaled by.
+#[derive(Clone, Copy, Debug)]
+struct Branch {
+    depth: u32,
+    weight: f32,
+}
+
+/// What one primary ray's tree may still spend, and where its statistics go.
+struct Work<'t> {
+    tally: &'t mut RayTally,
+    rays_left: u32,
+}
+
 impl Integrator<'_> {
     /// Colour and coverage (alpha 1 on geometry, 0 on the background) of a primary ray.
     pub fn primary(&self, ray: &Ray, tally: &mut RayTally) -> Vec4 {
         let precision = self.settings.precision;
-        let (color, hit) = self.radiance(ray, &precision, RayKind::Primary, 1, tally);
+        let mut work = Work {
+            tally,
+            rays_left: MAX_TREE_RAYS,
+        };
+        let root = Branch {
+            depth: 1,
+            weight: 1.0,
+        };
+        let (color, hit) = self.radiance(ray, &precision, RayKind::Primary, root, &mut work);
         color.extend(if hit { 1.0 } else { 0.0 })
     }
 
+    /// Radiance of a secondary ray leaving a surface at `from` whose contribution is scaled
+    /// by `coefficient`, or black, counted as cut, when its weight falls below the plan's
+    /// [`min_weight`](EffectPlan::min_weight) (adaptive depth control, POV-Ray's
+    /// `adc_bailout`) or the tree has spent [`MAX_TREE_RAYS`].
+    fn secondary(
+        &self,
+        ray: &Ray,
+        precision: &Precision,
+        kind: RayKind,
+        (from, coefficient): (Branch, f32),
+        work: &mut Work,
+    ) -> Vec3 {
+        let branch = Branch {
+            depth: from.depth + 1,
+            weight: from.weight * coefficient,
+        };
+        if branch.weight < self.settings.plan.min_weight || work.rays_left == 0 {
+            work.tally.cut_ray();
+            return Vec3::ZERO;
+        }
+        self.radiance(ray, precision, kind, branch, work).0
+    }
+
     /// Radiance along `ray`, traced by `precision` (for secondary rays,
-    /// [`Precision::leaving`] the surface they start on), which is of the given kind at path
-    /// depth `depth` (primary = 1), and whether it hit anything.
+    /// [`Precision::leaving`] the surface they start on), which is of the given kind at
+    /// `branch` of its tree, and whether it hit anything.
     fn radiance(
         &self,
         ray: &Ray,
         precision: &Precision,
         kind: RayKind,
-        depth: u32,
-        tally: &mut RayTally,
+        branch: Branch,
+        work: &mut Work,
     ) -> (Vec3, bool) {
+        work.rays_left = work.rays_left.saturating_sub(1);
+        let tally = &mut *work.tally;
         let mut q = QueryStats::default();
         let hit = self.geometry.intersect(ray, precision, &mut q);
         tally.record(kind, &q);
@@ -103,7 +150,7 @@ impl Integrator<'_> {
                 };
                 let mut q = QueryStats::default();
                 let blocked = self.geometry.occluded(&shadow, &leaving, &mut q);
-                tally.record(RayKind::Shadow, &q);
+                work.tally.record(RayKind::Shadow, &q);
                 if blocked {
                     continue;
                 }
@@ -121,11 +168,11 @@ impl Integrator<'_> {
             }
         }
 
-        if depth < plan.max_depth {
+        if branch.depth < plan.max_depth {
             if m.reflect > 0.0 && plan.reflection {
                 let r = Ray::new(above, reflect(d, n));
                 let kind = RayKind::Reflection;
-                color += m.reflect * self.radiance(&r, &leaving, kind, depth + 1, tally).0;
+                color += m.reflect * self.secondary(&r, &leaving, kind, (branch, m.reflect), work);
             }
             if m.transmit > 0.0 && plan.refraction {
                 let through = self.transmitted(
@@ -135,8 +182,8 @@ impl Integrator<'_> {
                     outside,
                     m.ior,
                     (&hit.leave_box, &leaving),
-                    depth,
-                    tally,
+                    (branch, m.transmit),
+                    work,
                 );
                 color += m.transmit * through;
             }
@@ -147,7 +194,7 @@ impl Integrator<'_> {
     /// Light through a transmissive surface: refraction weighted by 1 − Fresnel, plus the
     /// Fresnel reflection; all reflection under total internal reflection. `n` is the
     /// shading normal and `n_out` the geometric one, both on the incoming side; the rays
-    /// leave `leave_box` and are traced by `leaving`.
+    /// leave `leave_box` and are traced by `leaving`, from `from`, scaled by `transmit`.
     #[allow(clippy::too_many_arguments)]
     fn transmitted(
         &self,
@@ -157,8 +204,8 @@ impl Integrator<'_> {
         entering: bool,
         ior: f32,
         (leave_box, leaving): (&crate::geom::Aabb, &Precision),
-        depth: u32,
-        tally: &mut RayTally,
+        (from, transmit): (Branch, f32),
+        work: &mut Work,
     ) -> Vec3 {
         let ulps = self.settings.ulps;
         let eta = if entering { 1.0 / ior } else { ior };
@@ -169,21 +216,18 @@ impl Integrator<'_> {
             reflect(d, n),
         );
         if k < 0.0 {
-            return self
-                .radiance(&reflected, leaving, RayKind::Reflection, depth + 1, tally)
-                .0;
+            let weight = (from, transmit);
+            return self.secondary(&reflected, leaving, RayKind::Reflection, weight, work);
         }
         let t_dir = eta * d + (eta * cos_i - k.sqrt()) * n;
         // Schlick uses the cosine on the optically thinner side.
         let cos = if entering { cos_i } else { k.sqrt() };
         let f = schlick(cos, ior);
         let refracted = Ray::new(secondary_origin(leave_box, n_out, false, ulps), t_dir);
-        let through = self
-            .radiance(&refracted, leaving, RayKind::Refraction, depth + 1, tally)
-            .0;
-        let mirror = self
-            .radiance(&reflected, leaving, RayKind::Reflection, depth + 1, tally)
-            .0;
+        let weight = (from, transmit * (1.0 - f));
+        let through = self.secondary(&refracted, leaving, RayKind::Refraction, weight, work);
+        let weight = (from, transmit * f);
+        let mirror = self.secondary(&reflected, leaving, RayKind::Reflection, weight, work);
         (1.0 - f) * through + f * mirror
     }
 }

@@ -69,6 +69,9 @@ impl Tally {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct RayTally {
     counts: [u64; 4],
+    /// Secondary rays not traced: weight below the plan's minimum, or the tree's budget
+    /// spent.
+    cut: u64,
     surface_tests: Tally,
     patch_tests: Tally,
     splits: Tally,
@@ -96,10 +99,16 @@ impl RayTally {
         self.cached.add(&q.kernel.cached);
     }
 
+    /// Counts a secondary ray that was not traced (adaptive depth control).
+    pub fn cut_ray(&mut self) {
+        self.cut += 1;
+    }
+
     pub fn merge(mut self, o: RayTally) -> RayTally {
         for (a, b) in self.counts.iter_mut().zip(o.counts) {
             *a += b;
         }
+        self.cut += o.cut;
         self.surface_tests.merge(&o.surface_tests);
         self.patch_tests.merge(&o.patch_tests);
         self.splits.merge(&o.splits);
@@ -134,6 +143,7 @@ impl RayTally {
             reflection: self.counts[RayKind::Reflection as usize],
             refraction: self.counts[RayKind::Refraction as usize],
             total: n,
+            cut_off: self.cut,
             surfaces_tested_per_ray: self.surface_tests.spread(n),
             patch_tests_per_ray: self.patch_tests.spread(n),
             splits_per_ray: self.splits.spread(n),
@@ -163,6 +173,9 @@ pub struct RayReport {
     pub reflection: u64,
     pub refraction: u64,
     pub total: u64,
+    /// Secondary rays not traced because their weight fell below `plan.min_weight`
+    /// (adaptive depth control) or their primary ray's tree reached its ray budget.
+    pub cut_off: u64,
     /// Primitives whose outermost box the accelerator tested (LG90 §7.1 "surfaces tested
     /// per ray"): the grid's tight-box tests, or the primitives of the BVH leaves reached.
     pub surfaces_tested_per_ray: Spread,

@@ -28,9 +28,10 @@ pub struct ConversionReport {
     pub memory_ratio: f64,
 }
 
-/// Replaces every NURBS surface with its Bézier patches, in span order (u spans fastest),
-/// keeping trims with the first patch's surface entry dropped: trims of a NURBS surface
-/// refer to its parameter space, which each patch keeps in its domain rectangle.
+/// Replaces every NURBS surface with its Bézier patches, in span order (u spans fastest).
+/// Each patch keeps the surface's trim loops: they are written in the surface's parameter
+/// space, which each patch keeps as its domain rectangle, so culling and the trim test see
+/// the same region as before.
 pub fn convert_scene(scene: &Scene) -> (Scene, ConversionReport) {
     let mut report = ConversionReport::default();
     let mut out = scene.clone();
@@ -58,7 +59,11 @@ pub fn convert_scene(scene: &Scene) -> (Scene, ConversionReport) {
                         report.bezier_patches_from_nurbs += 1;
                         report.bezier_control_points_from_nurbs += p.point_count();
                         report.bezier_bytes += p.point_count() * BYTES_PER_POINT;
-                        converted.push(Surface::bezier(p));
+                        converted.push(Surface {
+                            geometry: SurfaceGeometry::Bezier(p),
+                            trims: s.trims.clone(),
+                            trim_space: s.trim_space.clone(),
+                        });
                     }
                 }
             }

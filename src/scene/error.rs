@@ -26,11 +26,36 @@ impl ParseError {
     }
 }
 
+/// A content error at a byte offset of a binary file (a GLB header or chunk): what a
+/// line and column are to a text file.
+#[derive(Debug, Error, Clone, PartialEq)]
+#[error("byte {offset}: {message}")]
+pub struct BinaryError {
+    pub offset: usize,
+    pub message: String,
+}
+
+impl BinaryError {
+    pub fn new(offset: usize, message: impl Into<String>) -> Self {
+        BinaryError {
+            offset,
+            message: message.into(),
+        }
+    }
+}
+
 /// Anything that can go wrong loading or saving a scene.
 #[derive(Debug, Error)]
 pub enum LoadError {
     #[error(transparent)]
     Parse(#[from] ParseError),
+    /// An error at a byte offset of a binary file.
+    #[error("{}: {source}", path.display())]
+    Binary {
+        path: PathBuf,
+        #[source]
+        source: BinaryError,
+    },
     #[error("{}: {source}", path.display())]
     Io {
         path: PathBuf,
@@ -51,6 +76,13 @@ impl LoadError {
         }
     }
 
+    pub fn binary(path: &Path, source: BinaryError) -> Self {
+        LoadError::Binary {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+
     pub fn invalid(path: &Path, message: impl Into<String>) -> Self {
         LoadError::Invalid {
             path: path.to_path_buf(),
@@ -62,4 +94,43 @@ impl LoadError {
 /// Reads a whole text file, naming the path on failure.
 pub fn read_text(path: &Path) -> Result<String, LoadError> {
     std::fs::read_to_string(path).map_err(|e| LoadError::io(path, e))
+}
+
+/// The 1-based line and column (in characters) of byte offset `byte` of `src`, for readers
+/// that find a problem by offset (a JSON value, a RON key, a base64 digit); offsets past
+/// the end give the end, and an offset inside a character counts as that character.
+pub fn line_column(src: &str, byte: usize) -> (usize, usize) {
+    let mut end = byte.min(src.len());
+    while !src.is_char_boundary(end) {
+        end -= 1;
+    }
+    let before = &src[..end];
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let line = before.matches('\n').count() + 1;
+    (line, before[line_start..].chars().count() + 1)
+}
+
+impl ParseError {
+    /// An error at byte offset `byte` of the text `src` of `path`.
+    pub fn at_byte(path: &Path, src: &str, byte: usize, message: impl Into<String>) -> Self {
+        let (line, column) = line_column(src, byte);
+        ParseError::new(path, line, column, message)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn byte_offsets_become_lines_and_character_columns() {
+        let src = "ab\nçd\n";
+        assert_eq!(line_column(src, 0), (1, 1));
+        assert_eq!(line_column(src, 2), (1, 3));
+        assert_eq!(line_column(src, 3), (2, 1));
+        // 'ç' is two bytes: 'd' at byte 5 is the second character.
+        assert_eq!(line_column(src, 5), (2, 2));
+        assert_eq!(line_column(src, 4), (2, 1));
+        assert_eq!(line_column(src, 99), (3, 1));
+    }
 }

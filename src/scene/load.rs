@@ -3,8 +3,9 @@
 use std::path::Path;
 
 use super::error::LoadError;
+use super::model::Material;
 use super::model::{Axis, Geometry, Object, Scene, Surface};
-use super::{bpt, cage, mesh, obj, pbrt, ron_format};
+use super::{bpt, cage, gltf_mesh, iges, mesh, obj, pbrt, ron_format, step};
 
 /// The kinds of input file we read, by extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -14,6 +15,8 @@ pub enum InputKind {
     Obj,
     Pbrt,
     Gltf,
+    Iges,
+    Step,
 }
 
 impl InputKind {
@@ -25,6 +28,8 @@ impl InputKind {
             "obj" => InputKind::Obj,
             "pbrt" => InputKind::Pbrt,
             "gltf" | "glb" => InputKind::Gltf,
+            "igs" | "iges" => InputKind::Iges,
+            "step" | "stp" => InputKind::Step,
             _ => return None,
         })
     }
@@ -33,7 +38,7 @@ impl InputKind {
 fn unknown_kind(path: &Path) -> LoadError {
     LoadError::invalid(
         path,
-        "unknown file type: expected .ron (scene), .bpt, .obj, .pbrt, .gltf or .glb",
+        "unknown file type: expected .ron (scene), .bpt, .obj, .pbrt, .gltf, .glb, .igs, .iges, .step or .stp",
     )
 }
 
@@ -58,7 +63,15 @@ pub fn load_geometry(path: &Path) -> Result<Geometry, LoadError> {
             let src = super::error::read_text(path)?;
             Ok(Geometry::Surfaces(pbrt::parse_pbrt(path, &src)?))
         }
-        InputKind::Gltf => Ok(Geometry::Mesh(mesh::read_gltf(path)?)),
+        InputKind::Gltf => Ok(Geometry::Mesh(gltf_mesh::read_gltf(path)?)),
+        InputKind::Iges => Ok(Geometry::Surfaces(
+            read_iges_warning(path)?
+                .surfaces
+                .into_iter()
+                .map(|d| d.surface)
+                .collect(),
+        )),
+        InputKind::Step => step::load_geometry(path),
         InputKind::Ron => Err(LoadError::invalid(
             path,
             "a scene cannot be used as geometry; reference its geometry files instead",
@@ -76,17 +89,21 @@ pub fn default_up(kind: InputKind) -> Axis {
     }
 }
 
-/// `--up`: frames bare geometry read from `path` with `up` pointing up instead of its
-/// format's default. A RON scene has its own camera, so it is refused there.
+/// Frames bare geometry read from `path` again after `--width`/`--height` (the fit depends
+/// on the aspect ratio) with `up` pointing up, or its format's default. A RON scene has its
+/// own camera: it is left alone, and `--up` is refused there.
 pub fn reframe(path: &Path, scene: &mut Scene, up: Option<Axis>) -> Result<(), LoadError> {
-    let Some(up) = up else { return Ok(()) };
-    if InputKind::of(path) == Some(InputKind::Ron) {
-        return Err(LoadError::invalid(
-            path,
-            "--up frames bare geometry; in a scene, set the camera, or give an object `up: Y`",
-        ));
+    let kind = InputKind::of(path).ok_or_else(|| unknown_kind(path))?;
+    if kind == InputKind::Ron {
+        return match up {
+            Some(_) => Err(LoadError::invalid(
+                path,
+                "--up frames bare geometry; in a scene, set the camera, or give an object `up: Y`",
+            )),
+            None => Ok(()),
+        };
     }
-    scene.frame_bare(up);
+    scene.frame_bare(up.unwrap_or(default_up(kind)));
     Ok(())
 }
 
@@ -110,11 +127,13 @@ pub fn load_subdivision(path: &Path) -> Result<Geometry, LoadError> {
         }
         InputKind::Gltf => Ok(Geometry::Subdivision(cage::mesh_cage(
             path,
-            &mesh::read_gltf(path)?,
+            &gltf_mesh::read_gltf(path)?,
         )?)),
         InputKind::Bpt => Err(refuse("a .bpt file of Bézier patches")),
         InputKind::Pbrt => Err(refuse("a pbrt file")),
         InputKind::Ron => Err(refuse("a RON scene")),
+        InputKind::Iges => Err(refuse("an IGES file")),
+        InputKind::Step => Err(refuse("a STEP file")),
     }
 }
 
@@ -133,19 +152,57 @@ pub fn load_scene(path: &Path) -> Result<Scene, LoadError> {
 
 /// [`load_scene`] with options for bare geometry.
 pub fn load_scene_with(path: &Path, options: LoadOptions) -> Result<Scene, LoadError> {
-    let scene = if options.subdivide {
+    Ok(load_scene_noted(path, options)?.0)
+}
+
+/// [`load_scene_with`], with what the reader noted about the file beyond the scene (a
+/// STEP file's units, unsupported entities, faces left out), one line each, for `info`.
+pub fn load_scene_noted(
+    path: &Path,
+    options: LoadOptions,
+) -> Result<(Scene, Vec<String>), LoadError> {
+    let (scene, notes) = if options.subdivide {
         if InputKind::of(path) == Some(InputKind::Ron) {
             return Err(LoadError::invalid(
                 path,
                 "--subdivide applies to bare mesh files; in a RON scene write `geometry: Subdivision(File(\"cage.obj\"))`",
             ));
         }
-        bare_scene(path, load_subdivision(path)?)
+        (bare_scene(path, load_subdivision(path)?), Vec::new())
+    } else if InputKind::of(path) == Some(InputKind::Step) {
+        let model = step::read_step(path)?;
+        if let Some(w) = model.report.warning(path) {
+            eprintln!("{w}");
+        }
+        let mut scene = Scene::framing(model.objects);
+        scene.materials = model.materials;
+        (scene, model.report.lines())
     } else {
-        read_any_scene(path)?
+        (read_any_scene(path)?, Vec::new())
     };
     check_f32_range(path, &scene)?;
-    Ok(scene)
+    check_trims(path, &scene)?;
+    Ok((scene, notes))
+}
+
+/// Every trim loop converts to Bézier pieces (degrees, knots, weights, ranges), checked
+/// once at load so that the renderer never meets loops it cannot apply; the error names
+/// the object and surface.
+pub fn check_trims(path: &Path, scene: &Scene) -> Result<(), LoadError> {
+    for o in &scene.objects {
+        let Geometry::Surfaces(surfaces) = &o.geometry else {
+            continue;
+        };
+        for (k, s) in surfaces.iter().enumerate() {
+            if let Err(e) = s.trim_region() {
+                return Err(LoadError::invalid(
+                    path,
+                    format!("object \"{}\", surface {k}: trim loops: {e}", o.name),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Smallest object extent the renderer accepts: 2^-60 ≈ 8.7e-19. Shading squares
@@ -174,23 +231,113 @@ pub fn check_f32_range(path: &Path, scene: &Scene) -> Result<(), LoadError> {
             ));
         }
         let largest = b.min.abs().max(b.max.abs()).max_element();
-        if !((largest as f32).is_finite()) {
+        // Box arithmetic (slab tests, extents, the default camera's distance) works on
+        // differences of coordinates, so the extent must fit as well: a patch at ±3e38
+        // has finite corners but an infinite f32 width.
+        if !((largest as f32).is_finite()) || !((extent as f32).is_finite()) {
             return Err(LoadError::invalid(
                 path,
                 format!(
-                    "object \"{}\": coordinates reach {largest:e} after transforms, beyond the f32 range (±{:e}) the renderer works in",
+                    "object \"{}\": coordinates reach {largest:e} and the box spans {extent:e} after transforms, beyond the f32 range (±{:e}) the renderer works in; scale the scene down",
                     o.name,
                     f32::MAX
                 ),
             ));
         }
     }
+    let c = &scene.camera;
+    if !(c.eye.as_vec3().is_finite() && c.look_at.as_vec3().is_finite()) {
+        return Err(LoadError::invalid(
+            path,
+            format!(
+                "camera: eye {} or look_at {} is beyond the f32 range (±{:e}) the renderer works in",
+                c.eye,
+                c.look_at,
+                f32::MAX
+            ),
+        ));
+    }
     Ok(())
+}
+
+/// Reads an IGES file and prints what was not drawn as one warning line on stderr (and
+/// each surface that could not be converted), so nothing is dropped silently.
+fn read_iges_warning(path: &Path) -> Result<iges::Iges, LoadError> {
+    let read = iges::read_iges(path)?;
+    let r = &read.report;
+    if let Some(line) = r.ignored_line() {
+        eprintln!("warning: {}: {line}", path.display());
+    }
+    for f in &r.failed {
+        eprintln!("warning: {}: surface not converted: {f}", path.display());
+    }
+    if r.projected > 0 {
+        eprintln!(
+            "warning: {}: {} trim curve(s) projected from model space, largest projection error {:e}",
+            path.display(),
+            r.projected,
+            r.max_projection_error
+        );
+    }
+    Ok(read)
+}
+
+/// A bare IGES file as a scene: one object per colour (IGES 314 or the Directory Entry's
+/// predefined colour), each with its material, framed like any bare geometry.
+fn iges_scene(path: &Path) -> Result<Scene, LoadError> {
+    let read = read_iges_warning(path)?;
+    let stem = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut colours: Vec<Option<glam::DVec3>> = Vec::new();
+    let mut groups: Vec<Vec<super::model::Surface>> = Vec::new();
+    for d in read.surfaces {
+        let k = match colours.iter().position(|c| *c == d.colour) {
+            Some(k) => k,
+            None => {
+                colours.push(d.colour);
+                groups.push(Vec::new());
+                colours.len() - 1
+            }
+        };
+        groups[k].push(d.surface);
+    }
+    let mut materials = vec![Material::default_named("default")];
+    let objects = colours
+        .iter()
+        .zip(groups)
+        .enumerate()
+        .map(|(k, (colour, surfaces))| {
+            let material = match colour {
+                Some(rgb) => {
+                    let mut m = Material::default_named(&format!("iges_colour_{k}"));
+                    m.diffuse = rgb.as_vec3();
+                    materials.push(m);
+                    materials.len() - 1
+                }
+                None => 0,
+            };
+            Object {
+                name: if k == 0 {
+                    stem.clone()
+                } else {
+                    format!("{stem}#{k}")
+                },
+                material,
+                geometry: Geometry::Surfaces(surfaces),
+            }
+        })
+        .collect();
+    let mut scene = Scene::framing(objects);
+    scene.materials = materials;
+    Ok(scene)
 }
 
 fn read_any_scene(path: &Path) -> Result<Scene, LoadError> {
     match InputKind::of(path).ok_or_else(|| unknown_kind(path))? {
         InputKind::Ron => ron_format::read_scene(path),
+        InputKind::Iges => iges_scene(path),
         _ => Ok(bare_scene(path, load_geometry(path)?)),
     }
 }

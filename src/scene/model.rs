@@ -7,7 +7,7 @@ use crate::geom::BezierPatch;
 use crate::geom::bbox::DAabb;
 use crate::geom::nurbs::NurbsSurface;
 use crate::geom::subdiv::SubdivisionSurface;
-use crate::geom::trim::{AxisMap, TrimLoop};
+use crate::geom::trim::{AxisMap, Coverage, PatchTrim, TrimError, TrimLoop, TrimRegion};
 
 /// Camera per the DESIGN.md contract.
 #[derive(Clone, Debug, PartialEq)]
@@ -19,6 +19,39 @@ pub struct Camera {
     pub fov_y: f64,
     pub width: u32,
     pub height: u32,
+}
+
+/// Longest image edge, in pixels (2^15).
+pub const MAX_IMAGE_EDGE: u32 = 1 << 15;
+
+/// Largest film one render holds, in pixels: 2^26 (8192 × 8192). The film keeps an `f32`
+/// RGBA value per pixel, 16 bytes, so this is 1 GiB; a 100000 × 100000 request asked for
+/// 160 GB at once (issue 21). Larger images are rendered in pieces (`--tile`, `--crop`).
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 26;
+
+impl Camera {
+    /// Refuses an image with a zero edge or an edge beyond [`MAX_IMAGE_EDGE`].
+    pub fn check_size(&self) -> Result<(), String> {
+        let (w, h) = (self.width, self.height);
+        if w == 0 || h == 0 || w > MAX_IMAGE_EDGE || h > MAX_IMAGE_EDGE {
+            return Err(format!(
+                "width and height must be 1 to {MAX_IMAGE_EDGE}, found {w}x{h}"
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Refuses a film (the image, or the piece of it one render makes) of more than
+/// [`MAX_IMAGE_PIXELS`], naming the budget.
+pub fn check_film_pixels(width: u32, height: u32) -> Result<(), String> {
+    let pixels = u64::from(width) * u64::from(height);
+    if pixels > MAX_IMAGE_PIXELS {
+        return Err(format!(
+            "a {width}x{height} film has {pixels} pixels, above the budget of {MAX_IMAGE_PIXELS} (8192x8192: 1 GiB of f32 RGBA); render it in pieces with --tile K/N or --crop"
+        ));
+    }
+    Ok(())
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -95,7 +128,37 @@ impl Surface {
             SurfaceGeometry::Nurbs(n) => n.transform(m),
         }
     }
+
+    /// The region the trim loops keep, `None` without loops; an error for loops that cannot
+    /// be converted (the readers check this at load, [`crate::scene::check_trims`]).
+    pub fn trim_region(&self) -> Result<Option<TrimRegion>, TrimError> {
+        TrimRegion::new(&self.trims, &self.trim_space)
+    }
+
+    /// The surface's Bézier patches in contract order, each with what its trim loops leave
+    /// of it ([`Coverage`]): a patch they cut away wholly is `Outside`.
+    pub fn trimmed_patches(&self) -> Vec<(BezierPatch, Coverage)> {
+        let patches = match &self.geometry {
+            SurfaceGeometry::Bezier(p) => vec![p.clone()],
+            SurfaceGeometry::Nurbs(n) => n.to_bezier_patches(),
+        };
+        // Loops that fail to convert were refused at load; were one to get here, the
+        // surface is drawn untrimmed rather than not at all.
+        match self.trim_region().ok().flatten() {
+            None => patches.into_iter().map(|p| (p, Coverage::Inside)).collect(),
+            Some(region) => patches
+                .into_iter()
+                .map(|p| {
+                    let coverage = region.coverage(p.domain());
+                    (p, coverage)
+                })
+                .collect(),
+        }
+    }
 }
+
+/// A patch ready for the renderer: its trim, where its loops cut it.
+pub type TrimmedPatch = (BezierPatch, Option<Box<PatchTrim>>);
 
 /// An indexed triangle mesh with optional per-vertex normals.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -171,6 +234,25 @@ impl Object {
         match &self.geometry {
             Geometry::Subdivision(s) => s.face_uv(patch as usize, u, v).unwrap_or((patch, u, v)),
             _ => (patch, u, v),
+        }
+    }
+
+    /// The object's patches in contract order with their trims; `None` for a patch its
+    /// trim loops cut away wholly (it keeps its number, as the contract numbers patches in
+    /// file order).
+    pub fn trimmed_patches(&self) -> Vec<Option<TrimmedPatch>> {
+        match &self.geometry {
+            Geometry::Surfaces(surfaces) => surfaces
+                .iter()
+                .flat_map(|s| s.trimmed_patches())
+                .map(|(p, coverage)| match coverage {
+                    Coverage::Outside => None,
+                    Coverage::Inside => Some((p, None)),
+                    Coverage::Partial(trim) => Some((p, Some(trim))),
+                })
+                .collect(),
+            Geometry::Subdivision(s) => s.patches.iter().map(|p| Some((p.clone(), None))).collect(),
+            Geometry::Mesh(_) => Vec::new(),
         }
     }
 
@@ -337,5 +419,31 @@ impl Scene {
 
     pub fn patch_count(&self) -> usize {
         self.objects.iter().map(|o| o.bezier_patches().len()).sum()
+    }
+
+    /// The number of trim loops over all surfaces.
+    pub fn trim_loop_count(&self) -> usize {
+        self.surfaces().map(|s| s.trims.len()).sum()
+    }
+
+    /// The same scene with every trim loop removed (`--ignore-trims`: to see what trimming
+    /// removes).
+    pub fn without_trims(mut self) -> Scene {
+        for o in &mut self.objects {
+            if let Geometry::Surfaces(surfaces) = &mut o.geometry {
+                for s in surfaces {
+                    s.trims.clear();
+                }
+            }
+        }
+        self
+    }
+
+    /// Every free-form surface of every object.
+    pub fn surfaces(&self) -> impl Iterator<Item = &Surface> {
+        self.objects.iter().flat_map(|o| match &o.geometry {
+            Geometry::Surfaces(s) => s.as_slice(),
+            Geometry::Mesh(_) | Geometry::Subdivision(_) => &[],
+        })
     }
 }

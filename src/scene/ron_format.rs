@@ -10,8 +10,11 @@ use serde::{Deserialize, Serialize};
 use super::animation::{CameraKey, CameraPath};
 use super::error::{LoadError, ParseError};
 use super::model::*;
+use super::ron_locate::RonLocator;
 use crate::geom::BezierPatch;
+use crate::geom::bezier::ParamRect;
 use crate::geom::nurbs::NurbsSurface;
+use crate::geom::trim::{AxisMap, ParamCurve, TrimLoop, TrimSegment};
 
 type V3 = (f64, f64, f64);
 type C3 = (f32, f32, f32);
@@ -162,6 +165,15 @@ pub enum SurfaceDef {
         points: Vec<V3>,
         #[serde(default, skip_serializing_if = "Option::is_none")]
         weights: Option<Vec<f64>>,
+        /// The rectangle `(u0, u1, v0, v1)` of its surface's parameters the patch covers,
+        /// which its trim loops are written in; `[0,1]²` when absent.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        domain: Option<(f64, f64, f64, f64)>,
+        /// Trim loops, as for `Nurbs`.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        trims: Vec<TrimLoopDef>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        trim_space: Option<(AxisMapDef, AxisMapDef)>,
     },
     /// A NURBS surface: degrees, knot vectors, control net size (nu, nv), points u fastest.
     Nurbs {
@@ -172,7 +184,38 @@ pub enum SurfaceDef {
         points: Vec<V3>,
         #[serde(default, skip_serializing_if = "Option::is_none")]
         weights: Option<Vec<f64>>,
+        /// Trim loops (even–odd over all loops) in the trim parameter space.
+        #[serde(default, skip_serializing_if = "Vec::is_empty")]
+        trims: Vec<TrimLoopDef>,
+        /// How (u, v) map to the trim parameters; identity when absent.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        trim_space: Option<(AxisMapDef, AxisMapDef)>,
     },
+}
+
+/// A trim loop: the outer boundary or a hole.
+#[derive(Debug, Serialize, Deserialize)]
+pub struct TrimLoopDef {
+    pub hole: bool,
+    pub segments: Vec<TrimSegmentDef>,
+}
+
+/// A B-spline trim curve restricted to `[t0, t1]`: homogeneous points `(w u, w v, w)` and
+/// `points + degree + 1` knots.
+#[derive(Debug, Serialize, Deserialize)]
+pub struct TrimSegmentDef {
+    pub t0: f64,
+    pub t1: f64,
+    pub degree: usize,
+    pub knots: Vec<f64>,
+    pub points: Vec<V3>,
+}
+
+/// [`AxisMap`] in the file.
+#[derive(Debug, Serialize, Deserialize)]
+pub enum AxisMapDef {
+    Identity,
+    Arcs { breaks: Vec<f64>, angles: Vec<f64> },
 }
 
 /// Transforms, applied in the order listed.
@@ -233,10 +276,27 @@ pub fn parse_scene_file(path: &Path, src: &str) -> Result<SceneFile, ParseError>
 pub fn read_scene(path: &Path) -> Result<Scene, LoadError> {
     let src = super::error::read_text(path)?;
     let file = parse_scene_file(path, &src)?;
-    build_scene(path, file)
+    build_scene(path, &RonLocator::new(path, &src), file)
 }
 
-fn build_scene(path: &Path, file: SceneFile) -> Result<Scene, LoadError> {
+/// The deepest `max_depth` a scene may ask for. Each level can double the ray tree (a
+/// material that both reflects and transmits), and the integrator recurses once per level,
+/// so an unbounded value overflowed the stack (issue 21: `max_depth: 100000`). 64 bounces
+/// is far beyond what an 8-bit or half-float pixel can show: with the adaptive cut-off a
+/// ray's weight falls below 1/255 long before, unless every surface is a perfect mirror.
+pub const MAX_TRACE_DEPTH: u32 = 64;
+
+fn build_scene(path: &Path, at: &RonLocator, file: SceneFile) -> Result<Scene, LoadError> {
+    if let Some(d) = file.max_depth
+        && !(1..=MAX_TRACE_DEPTH).contains(&d)
+    {
+        return Err(at
+            .at_key(
+                "max_depth",
+                format!("expected max_depth from 1 to {MAX_TRACE_DEPTH}, found {d}"),
+            )
+            .into());
+    }
     let c = &file.camera;
     let camera = Camera {
         eye: v3(c.eye),
@@ -246,16 +306,18 @@ fn build_scene(path: &Path, file: SceneFile) -> Result<Scene, LoadError> {
         width: c.width,
         height: c.height,
     };
-    validate_camera(path, &camera)?;
-    let animation = camera_path(path, c, &camera)?;
+    validate_camera(&camera).map_err(|m| at.at_key("camera", m))?;
+    let animation = camera_path(at, c, &camera)?;
     let max_spp = crate::render::sampler::MAX_SPP;
     if let Some(n) = file.samples
         && !(1..=max_spp).contains(&n)
     {
-        return Err(LoadError::invalid(
-            path,
-            format!("samples: expected a count from 1 to {max_spp}, found {n}"),
-        ));
+        return Err(at
+            .at_key(
+                "samples",
+                format!("samples: expected a count from 1 to {max_spp}, found {n}"),
+            )
+            .into());
     }
     let mut materials: Vec<Material> = file
         .materials
@@ -263,14 +325,14 @@ fn build_scene(path: &Path, file: SceneFile) -> Result<Scene, LoadError> {
         .map(|(name, m)| material_from_def(name, m))
         .collect();
     for m in &materials {
-        validate_material(path, m)?;
+        validate_material(m).map_err(|e| at.at_key(&m.name, e))?;
     }
     let base = path.parent().unwrap_or(Path::new("."));
     let mut objects = Vec::with_capacity(file.objects.len());
     for (index, o) in file.objects.iter().enumerate() {
         let material = match &o.material {
             Some(name) => materials.iter().position(|m| &m.name == name).ok_or_else(|| {
-                LoadError::invalid(path, format!("object {index} uses material \"{name}\", which is not defined in `materials`"))
+                at.at_object(index, format!("object {index} uses material \"{name}\", which is not defined in `materials`"))
             })?,
             None => {
                 if !materials.iter().any(|m| m.name == "default") {
@@ -280,16 +342,20 @@ fn build_scene(path: &Path, file: SceneFile) -> Result<Scene, LoadError> {
             }
         };
         let mut geometry = match &o.geometry {
-            GeometryDef::File(f) => super::load::load_geometry(&base.join(f))?,
+            GeometryDef::File(f) => super::load::load_geometry(&base.join(f))
+                .map_err(|e| referenced(at, index, f, e))?,
             GeometryDef::Subdivision(inner) => match inner.as_ref() {
-                GeometryDef::File(f) => super::load::load_subdivision(&base.join(f))?,
+                GeometryDef::File(f) => super::load::load_subdivision(&base.join(f))
+                    .map_err(|e| referenced(at, index, f, e))?,
                 _ => {
-                    return Err(LoadError::invalid(
-                        path,
-                        format!(
-                            "object {index}: expected Subdivision(File(\"cage.obj\")): a cage is read from a mesh file"
-                        ),
-                    ));
+                    return Err(at
+                        .at_object(
+                            index,
+                            format!(
+                                "object {index}: expected Subdivision(File(\"cage.obj\")): a cage is read from a mesh file"
+                            ),
+                        )
+                        .into());
                 }
             },
             GeometryDef::Surfaces(defs) => Geometry::Surfaces(
@@ -297,7 +363,7 @@ fn build_scene(path: &Path, file: SceneFile) -> Result<Scene, LoadError> {
                     .enumerate()
                     .map(|(k, d)| {
                         surface_from_def(d).map_err(|e| {
-                            LoadError::invalid(path, format!("object {index}, surface {k}: {e}"))
+                            at.at_surface(index, k, format!("object {index}, surface {k}: {e}"))
                         })
                     })
                     .collect::<Result<_, _>>()?,
@@ -358,19 +424,18 @@ fn build_scene(path: &Path, file: SceneFile) -> Result<Scene, LoadError> {
 /// The camera's animation, checked: an orbit has at least one frame and a finite angle;
 /// keyframes are in increasing frame order and each is a valid camera.
 fn camera_path(
-    path: &Path,
+    at: &RonLocator,
     def: &CameraDef,
     camera: &Camera,
-) -> Result<Option<CameraPath>, LoadError> {
+) -> Result<Option<CameraPath>, ParseError> {
     match (&def.orbit, def.keyframes.is_empty()) {
-        (Some(_), false) => Err(LoadError::invalid(
-            path,
-            "camera: give either orbit or keyframes, not both",
-        )),
+        (Some(_), false) => {
+            Err(at.at_key("orbit", "camera: give either orbit or keyframes, not both"))
+        }
         (Some(o), true) => {
             if o.frames == 0 || !o.degrees.is_finite() {
-                return Err(LoadError::invalid(
-                    path,
+                return Err(at.at_key(
+                    "orbit",
                     "camera: orbit needs frames >= 1 and a finite number of degrees",
                 ));
             }
@@ -386,8 +451,8 @@ fn camera_path(
                 if let Some(prev) = keys.last().map(|p: &CameraKey| p.frame)
                     && k.frame <= prev
                 {
-                    return Err(LoadError::invalid(
-                        path,
+                    return Err(at.at_key(
+                        "keyframes",
                         format!(
                             "camera: keyframe {i} (frame {}) does not come after frame {prev}",
                             k.frame
@@ -408,8 +473,8 @@ fn camera_path(
                     fov_y: key.fov_y,
                     ..camera.clone()
                 };
-                if let Err(LoadError::Invalid { message, .. }) = validate_camera(path, &posed) {
-                    return Err(LoadError::invalid(path, format!("keyframe {i}: {message}")));
+                if let Err(message) = validate_camera(&posed) {
+                    return Err(at.at_key("keyframes", format!("keyframe {i}: {message}")));
                 }
                 keys.push(key);
             }
@@ -418,42 +483,39 @@ fn camera_path(
     }
 }
 
-fn validate_camera(path: &Path, c: &Camera) -> Result<(), LoadError> {
-    let f = c.look_at - c.eye;
-    if !(c.eye.is_finite() && c.look_at.is_finite() && c.up.is_finite()) {
-        return Err(LoadError::invalid(
-            path,
-            "camera: eye, look_at and up must be finite",
-        ));
+/// An error loading the geometry file `file` of object `index`: the file's own parse
+/// errors already say where they are; anything else (a missing file, content the reader
+/// refuses without a place) is reported at the object that refers to the file.
+fn referenced(at: &RonLocator, index: usize, file: &str, e: LoadError) -> LoadError {
+    match e {
+        LoadError::Parse(p) => LoadError::Parse(p),
+        other => at
+            .at_object(
+                index,
+                format!("object {index} refers to geometry file \"{file}\": {other}"),
+            )
+            .into(),
     }
-    if f.length_squared() == 0.0 || f.cross(c.up).length_squared() == 0.0 {
-        return Err(LoadError::invalid(
-            path,
-            "camera: look_at must differ from eye, and up must not be parallel to the view direction",
-        ));
-    }
-    if !(c.fov_y > 0.0 && c.fov_y < 180.0) {
-        return Err(LoadError::invalid(
-            path,
-            format!(
-                "camera: fov_y must be between 0 and 180 degrees, found {}",
-                c.fov_y
-            ),
-        ));
-    }
-    if c.width == 0 || c.height == 0 || c.width > 1 << 15 || c.height > 1 << 15 {
-        return Err(LoadError::invalid(
-            path,
-            format!(
-                "camera: width and height must be 1 to 32768, found {}x{}",
-                c.width, c.height
-            ),
-        ));
-    }
-    Ok(())
 }
 
-fn validate_material(path: &Path, m: &Material) -> Result<(), LoadError> {
+fn validate_camera(c: &Camera) -> Result<(), String> {
+    let f = c.look_at - c.eye;
+    if !(c.eye.is_finite() && c.look_at.is_finite() && c.up.is_finite()) {
+        return Err("camera: eye, look_at and up must be finite".into());
+    }
+    if f.length_squared() == 0.0 || f.cross(c.up).length_squared() == 0.0 {
+        return Err("camera: look_at must differ from eye, and up must not be parallel to the view direction".into());
+    }
+    if !(c.fov_y > 0.0 && c.fov_y < 180.0) {
+        return Err(format!(
+            "camera: fov_y must be between 0 and 180 degrees, found {}",
+            c.fov_y
+        ));
+    }
+    c.check_size().map_err(|e| format!("camera: {e}"))
+}
+
+fn validate_material(m: &Material) -> Result<(), String> {
     let values = [
         m.specular,
         m.shininess,
@@ -465,19 +527,13 @@ fn validate_material(path: &Path, m: &Material) -> Result<(), LoadError> {
         m.diffuse.z,
     ];
     if values.iter().any(|v| !v.is_finite() || *v < 0.0) {
-        return Err(LoadError::invalid(
-            path,
-            format!(
-                "material \"{}\": values must be finite and non-negative",
-                m.name
-            ),
+        return Err(format!(
+            "material \"{}\": values must be finite and non-negative",
+            m.name
         ));
     }
     if m.ior <= 0.0 {
-        return Err(LoadError::invalid(
-            path,
-            format!("material \"{}\": ior must be positive", m.name),
-        ));
+        return Err(format!("material \"{}\": ior must be positive", m.name));
     }
     Ok(())
 }
@@ -520,11 +576,21 @@ fn surface_from_def(d: &SurfaceDef) -> Result<Surface, crate::geom::GeomError> {
             degree,
             points,
             weights,
-        } => Surface::bezier(BezierPatch::new(
-            degree.0,
-            degree.1,
-            homogeneous(points, weights)?,
-        )?),
+            domain,
+            trims,
+            trim_space,
+        } => {
+            let patch = BezierPatch::new(degree.0, degree.1, homogeneous(points, weights)?)?;
+            let patch = match domain {
+                &Some((u0, u1, v0, v1)) => patch.with_domain(ParamRect { u0, u1, v0, v1 }),
+                None => patch,
+            };
+            Surface {
+                geometry: SurfaceGeometry::Bezier(patch),
+                trims: trims_from_defs(trims)?,
+                trim_space: trim_space_from_def(trim_space)?,
+            }
+        }
         SurfaceDef::Nurbs {
             degree,
             knots_u,
@@ -532,6 +598,8 @@ fn surface_from_def(d: &SurfaceDef) -> Result<Surface, crate::geom::GeomError> {
             count,
             points,
             weights,
+            trims,
+            trim_space,
         } => Surface {
             geometry: SurfaceGeometry::Nurbs(NurbsSurface::new(
                 degree.0,
@@ -542,9 +610,135 @@ fn surface_from_def(d: &SurfaceDef) -> Result<Surface, crate::geom::GeomError> {
                 count.1,
                 homogeneous(points, weights)?,
             )?),
-            trims: Vec::new(),
-            trim_space: Default::default(),
+            trims: trims_from_defs(trims)?,
+            trim_space: trim_space_from_def(trim_space)?,
         },
+    })
+}
+
+fn trims_from_defs(defs: &[TrimLoopDef]) -> Result<Vec<TrimLoop>, crate::geom::GeomError> {
+    defs.iter()
+        .enumerate()
+        .map(|(i, l)| trim_loop_from_def(i, l))
+        .collect()
+}
+
+fn trim_space_from_def(
+    d: &Option<(AxisMapDef, AxisMapDef)>,
+) -> Result<[AxisMap; 2], crate::geom::GeomError> {
+    Ok(match d {
+        None => Default::default(),
+        Some((u, v)) => [axis_map_from_def(u)?, axis_map_from_def(v)?],
+    })
+}
+
+/// A trim loop, validated as the kernels expect: degrees 1..=15, valid knot vectors, finite
+/// points with positive weights, finite non-empty ranges.
+fn trim_loop_from_def(i: usize, l: &TrimLoopDef) -> Result<TrimLoop, crate::geom::GeomError> {
+    let bad = |j: usize, what: String| {
+        crate::geom::GeomError::Knots(format!("trim loop {i}, segment {j}: {what}"))
+    };
+    let segments = l
+        .segments
+        .iter()
+        .enumerate()
+        .map(|(j, s)| {
+            if !(1..=crate::geom::MAX_DEGREE).contains(&s.degree) {
+                return Err(bad(j, format!("degree {} is outside 1..=15", s.degree)));
+            }
+            crate::geom::nurbs::knots::validate(s.degree, &s.knots, s.points.len())
+                .map_err(|e| bad(j, e.to_string()))?;
+            if s.points
+                .iter()
+                .any(|p| !(p.0.is_finite() && p.1.is_finite() && p.2 > 0.0 && p.2.is_finite()))
+            {
+                return Err(bad(j, "points must be finite with positive weights".into()));
+            }
+            if !(s.t0.is_finite() && s.t1.is_finite() && s.t0 < s.t1) {
+                return Err(bad(
+                    j,
+                    format!("the range [{}, {}] is empty or not finite", s.t0, s.t1),
+                ));
+            }
+            Ok(TrimSegment {
+                t0: s.t0,
+                t1: s.t1,
+                curve: ParamCurve {
+                    degree: s.degree,
+                    knots: s.knots.clone(),
+                    points: s.points.iter().map(|&p| v3(p)).collect(),
+                },
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(TrimLoop {
+        hole: l.hole,
+        segments,
+    })
+}
+
+fn axis_map_from_def(d: &AxisMapDef) -> Result<AxisMap, crate::geom::GeomError> {
+    Ok(match d {
+        AxisMapDef::Identity => AxisMap::Identity,
+        AxisMapDef::Arcs { breaks, angles } => {
+            let increasing =
+                |v: &[f64]| v.iter().all(|x| x.is_finite()) && v.windows(2).all(|w| w[0] < w[1]);
+            if breaks.len() != angles.len()
+                || breaks.len() < 2
+                || !increasing(breaks)
+                || !increasing(angles)
+            {
+                return Err(crate::geom::GeomError::Knots(
+                    "trim_space: Arcs needs as many breaks as angles (at least 2), both increasing"
+                        .into(),
+                ));
+            }
+            AxisMap::Arcs {
+                breaks: breaks.clone(),
+                angles: angles.clone(),
+            }
+        }
+    })
+}
+
+fn axis_map_def(m: &AxisMap) -> AxisMapDef {
+    match m {
+        AxisMap::Identity => AxisMapDef::Identity,
+        AxisMap::Arcs { breaks, angles } => AxisMapDef::Arcs {
+            breaks: breaks.clone(),
+            angles: angles.clone(),
+        },
+    }
+}
+
+/// The RON form of a surface's trim loops.
+fn trim_defs(s: &Surface) -> Vec<TrimLoopDef> {
+    s.trims
+        .iter()
+        .map(|l| TrimLoopDef {
+            hole: l.hole,
+            segments: l
+                .segments
+                .iter()
+                .map(|g| TrimSegmentDef {
+                    t0: g.t0,
+                    t1: g.t1,
+                    degree: g.curve.degree,
+                    knots: g.curve.knots.clone(),
+                    points: g.curve.points.iter().map(|p| (p.x, p.y, p.z)).collect(),
+                })
+                .collect(),
+        })
+        .collect()
+}
+
+/// The RON form of a surface's trim space, `None` for the identity.
+fn trim_space_def(s: &Surface) -> Option<(AxisMapDef, AxisMapDef)> {
+    (s.trim_space != <[AxisMap; 2]>::default()).then(|| {
+        (
+            axis_map_def(&s.trim_space[0]),
+            axis_map_def(&s.trim_space[1]),
+        )
     })
 }
 
@@ -591,10 +785,14 @@ pub fn scene_to_file(scene: &Scene) -> Result<SceneFile, String> {
             .map(|s| match &s.geometry {
                 SurfaceGeometry::Bezier(p) => {
                     let (points, weights) = split_homogeneous(p.homogeneous_points());
+                    let d = p.domain();
                     SurfaceDef::Bezier {
                         degree: (p.degree_u(), p.degree_v()),
                         points,
                         weights,
+                        domain: (d != ParamRect::UNIT).then_some((d.u0, d.u1, d.v0, d.v1)),
+                        trims: trim_defs(s),
+                        trim_space: trim_space_def(s),
                     }
                 }
                 SurfaceGeometry::Nurbs(n) => {
@@ -606,6 +804,8 @@ pub fn scene_to_file(scene: &Scene) -> Result<SceneFile, String> {
                         count: (n.count_u, n.count_v),
                         points,
                         weights,
+                        trims: trim_defs(s),
+                        trim_space: trim_space_def(s),
                     }
                 }
             })

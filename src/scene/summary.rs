@@ -4,7 +4,8 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
-use super::model::{Geometry, Light, Scene, SurfaceGeometry};
+use super::model::{Geometry, Light, Scene, Surface, SurfaceGeometry};
+use crate::geom::trim::Coverage;
 
 #[derive(Debug, Serialize)]
 pub struct SceneSummary {
@@ -33,15 +34,79 @@ pub struct CameraSummary {
     pub height: u32,
 }
 
+/// A Catmull–Clark surface's construction (see [`crate::geom::subdiv::Stats`]).
+#[derive(Debug, Serialize)]
+pub struct SubdivisionSummary {
+    pub cage_vertices: usize,
+    pub cage_faces: usize,
+    /// Quads after the first Catmull–Clark step (the `trace` patch numbers).
+    pub quads: usize,
+    pub regular_patches: usize,
+    /// Final children at extraordinary vertices.
+    pub extraordinary_ends: usize,
+    pub t_junctions: usize,
+    /// Deepest refinement level (1: every quad regular).
+    pub levels: u32,
+}
+
 #[derive(Debug, Serialize)]
 pub struct ObjectSummary {
     pub name: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub subdivision: Option<SubdivisionSummary>,
     pub material: String,
     pub surfaces: usize,
     pub nurbs_surfaces: usize,
     pub patches: usize,
     pub trim_loops: usize,
     pub triangles: usize,
+    /// One entry per surface with trim loops.
+    pub trimmed_surfaces: Vec<TrimSummary>,
+}
+
+/// What a surface's trim loops are made of and what they leave of its patches.
+#[derive(Debug, Serialize)]
+pub struct TrimSummary {
+    /// The surface's number in its object, in file order.
+    pub surface: usize,
+    pub loops: usize,
+    pub holes: usize,
+    /// Loop segments (OBJ `curv2` pieces, IGES/STEP curves).
+    pub curves: usize,
+    /// Bézier pieces the curves became (after the monotone split).
+    pub pieces: usize,
+    /// Patches the loops cut, keep whole, and cut away (culled at load).
+    pub patches_cut: usize,
+    pub patches_whole: usize,
+    pub patches_culled: usize,
+}
+
+fn trim_summary(k: usize, s: &Surface) -> Option<TrimSummary> {
+    if s.trims.is_empty() {
+        return None;
+    }
+    let mut t = TrimSummary {
+        surface: k,
+        loops: s.trims.len(),
+        holes: s.trims.iter().filter(|l| l.hole).count(),
+        curves: s.trims.iter().map(|l| l.segments.len()).sum(),
+        pieces: s
+            .trim_region()
+            .ok()
+            .flatten()
+            .map_or(0, |r| r.piece_count()),
+        patches_cut: 0,
+        patches_whole: 0,
+        patches_culled: 0,
+    };
+    for (_, coverage) in s.trimmed_patches() {
+        match coverage {
+            Coverage::Partial(_) => t.patches_cut += 1,
+            Coverage::Inside => t.patches_whole += 1,
+            Coverage::Outside => t.patches_culled += 1,
+        }
+    }
+    Some(t)
 }
 
 pub fn summarize(scene: &Scene) -> SceneSummary {
@@ -71,8 +136,21 @@ pub fn summarize(scene: &Scene) -> SceneSummary {
         patches += bez.len();
         nurbs += n;
         triangles += tris;
+        let subdivision = match &o.geometry {
+            Geometry::Subdivision(sd) => Some(SubdivisionSummary {
+                cage_vertices: sd.cage.points.len(),
+                cage_faces: sd.stats.cage_faces,
+                quads: sd.stats.faces,
+                regular_patches: sd.stats.regular,
+                extraordinary_ends: sd.stats.extraordinary_ends,
+                t_junctions: sd.stats.t_junctions,
+                levels: sd.stats.levels,
+            }),
+            _ => None,
+        };
         objects.push(ObjectSummary {
             name: o.name.clone(),
+            subdivision,
             material: scene
                 .materials
                 .get(o.material)
@@ -83,6 +161,14 @@ pub fn summarize(scene: &Scene) -> SceneSummary {
             patches: bez.len(),
             trim_loops: trims,
             triangles: tris,
+            trimmed_surfaces: match &o.geometry {
+                Geometry::Surfaces(s) => s
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(k, s)| trim_summary(k, s))
+                    .collect(),
+                Geometry::Mesh(_) | Geometry::Subdivision(_) => Vec::new(),
+            },
         });
     }
     let b = scene.bounds();

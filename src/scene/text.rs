@@ -134,6 +134,21 @@ pub fn parse_finite(path: &Path, tok: &Token, what: &str) -> Result<f64, ParseEr
     }
 }
 
+/// The offset after the double-quoted string starting at byte `start` of `b` (a `"`),
+/// backslash escapes skipped (JSON, RFC 8259 §7, and RON strings alike), or the end of
+/// `b` for an unterminated string. For scanners that locate things in a text.
+pub fn quoted_end(b: &[u8], start: usize) -> usize {
+    let mut i = start + 1;
+    while i < b.len() {
+        match b[i] {
+            b'\\' => i += 2,
+            b'"' => return i + 1,
+            _ => i += 1,
+        }
+    }
+    b.len()
+}
+
 /// One logical line of a line-oriented format (OBJ): its words with their original
 /// positions, and the position just past its last character (where "found end of line"
 /// errors point).

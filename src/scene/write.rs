@@ -55,6 +55,15 @@ pub fn write_scene_as(path: &Path, scene: &super::model::Scene) -> Result<(), Lo
                 super::ron_format::scene_to_ron(scene).map_err(|m| LoadError::invalid(path, m))?;
             write_atomic(path, |w| w.write_all(text.as_bytes()))
         }
+        Some(InputKind::Bpt | InputKind::Obj) if scene.trim_loop_count() > 0 => {
+            Err(LoadError::invalid(
+                path,
+                format!(
+                    "the scene has {} trim loop(s), which patchtrace's .bpt and .obj writers do not store (the surfaces would come back untrimmed); write .ron instead",
+                    scene.trim_loop_count()
+                ),
+            ))
+        }
         Some(InputKind::Bpt) => {
             let patches = patches();
             if let Some(i) = patches.iter().position(|p| p.is_rational()) {

@@ -133,17 +133,21 @@ pub fn segments_for_tolerance(
     degree: usize,
     tolerance: f64,
 ) -> usize {
+    segments_until(degree, &|t0, t1| {
+        let (a, b) = (curve(t0), curve(t1));
+        CHORD_PROBES.iter().all(|&f| {
+            let p = curve(t0 + (t1 - t0) * f);
+            distance_to_segment(p, a, b) <= tolerance
+        })
+    })
+}
+
+/// The first count of equal parameter segments, doubling from the degree up to
+/// [`MAX_ADAPTIVE_SEGMENTS`], for which `fine(t0, t1)` holds on every segment.
+pub fn segments_until(degree: usize, fine: &dyn Fn(f64, f64) -> bool) -> usize {
     let mut n = degree.max(1);
     while n < MAX_ADAPTIVE_SEGMENTS {
-        let flat = (0..n).all(|s| {
-            let (t0, t1) = (s as f64 / n as f64, (s + 1) as f64 / n as f64);
-            let (a, b) = (curve(t0), curve(t1));
-            CHORD_PROBES.iter().all(|&f| {
-                let p = curve(t0 + (t1 - t0) * f);
-                distance_to_segment(p, a, b) <= tolerance
-            })
-        });
-        if flat {
+        if (0..n).all(|s| fine(s as f64 / n as f64, (s + 1) as f64 / n as f64)) {
             return n;
         }
         n *= 2;
@@ -151,7 +155,7 @@ pub fn segments_for_tolerance(
     MAX_ADAPTIVE_SEGMENTS
 }
 
-fn distance_to_segment(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+pub fn distance_to_segment(p: DVec3, a: DVec3, b: DVec3) -> f64 {
     let ab = b - a;
     let len2 = ab.length_squared();
     let t = if len2 > 0.0 {

@@ -9,9 +9,15 @@
 //! direction, and vertices are welded by their exact `f64` position. Where a patch's grid
 //! is finer than one of its boundary curves (adaptive mode), the ring of triangles next to
 //! that boundary is stitched by merging the two vertex loops by parameter ([`stitch`]).
+//!
+//! A trimmed surface is triangulated in its parameter domain instead, constrained to its
+//! sampled loops ([`trimmed`]); it is a piece of mesh of its own, and the gaps it leaves
+//! against its neighbouring trimmed faces are measured and reported ([`gaps`]).
 
 mod edge;
+pub mod gaps;
 mod stitch;
+mod trimmed;
 pub mod write;
 
 use std::collections::HashMap;
@@ -20,10 +26,11 @@ use glam::DVec3;
 use thiserror::Error;
 
 use crate::geom::BezierPatch;
-use crate::scene::model::{Geometry, Object, Scene, TriangleMesh};
+use crate::scene::model::{Geometry, Object, Scene, SurfaceGeometry, TriangleMesh};
 
 pub use edge::MAX_ADAPTIVE_SEGMENTS;
 use edge::{EdgeCurve, EdgeKey, Side, segments_for_tolerance};
+pub use gaps::TrimGaps;
 pub use write::{MeshFormat, write_mesh_scene};
 
 /// How finely each patch is cut.
@@ -54,17 +61,34 @@ pub enum TessellateError {
     Tolerance(f64),
     #[error("the mesh would have more than 2^32 - 1 vertices")]
     TooManyVertices,
-    #[error("object {0:?} has trimmed surfaces, which the tessellator does not support yet")]
-    Trimmed(String),
+    #[error("a trimmed surface's parameter point cannot be triangulated: {0}")]
+    Parameter(String),
+    #[error(
+        "the tessellation would reach {triangles} triangles by patch {patch} of object {object:?}, above the budget of {budget} (2^24 triangles, about 1 GB with their vertices); use a coarser --grid or --triangles-per-patch, or a larger --tolerance"
+    )]
+    Budget {
+        object: String,
+        patch: u32,
+        triangles: u64,
+        budget: u64,
+    },
 }
+
+/// Most triangles one tessellation may make: 2^24 (16.7 M), 12 bytes of indices each plus
+/// about half a vertex each (24 bytes, and the welding map's entry), about 1 GB in all.
+/// Dammertz's finest table row (131072 per patch) on the 32-patch teapot is 4.2 M;
+/// `--grid 100000,100000` asked for 40 GB (issue 21).
+pub const MAX_TRIANGLES: u64 = 1 << 24;
 
 /// Size of a tessellation. `bytes` is the memory the triangle path renders from: `f32`
 /// positions and normals (24 bytes per vertex) and `u32` indices (12 bytes per triangle).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+/// `trim_gaps` are the gaps between the trimmed faces of the tessellated object or scene.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct TessellationReport {
     pub triangles: u64,
     pub vertices: u64,
     pub bytes: u64,
+    pub trim_gaps: TrimGaps,
 }
 
 /// Bytes per vertex of the rendered mesh: three `f32` position and three `f32` normal
@@ -80,9 +104,12 @@ impl TessellationReport {
             triangles,
             vertices,
             bytes: vertices * BYTES_PER_VERTEX + triangles * BYTES_PER_TRIANGLE,
+            trim_gaps: TrimGaps::default(),
         }
     }
 
+    /// Adds the sizes; gaps are a property of the faces measured together, so they are left
+    /// to the caller that has them all ([`tessellate_scene`]).
     pub fn add(&mut self, other: &TessellationReport) {
         self.triangles += other.triangles;
         self.vertices += other.vertices;
@@ -113,13 +140,30 @@ pub fn tessellate_scene(
     scene: &Scene,
     mode: TessellationMode,
 ) -> Result<(Scene, TessellationReport), TessellateError> {
+    tessellate_scene_with(scene, mode, &mut || {})
+}
+
+/// [`tessellate_scene`], calling `patch_done()` after each patch, for a progress bar. The
+/// scene's triangles stay within [`MAX_TRIANGLES`] in all.
+pub fn tessellate_scene_with(
+    scene: &Scene,
+    mode: TessellationMode,
+    patch_done: &mut dyn FnMut(),
+) -> Result<(Scene, TessellationReport), TessellateError> {
     let mut report = TessellationReport::default();
     let mut objects = Vec::with_capacity(scene.objects.len());
+    let mut boundaries = Vec::new();
     for object in &scene.objects {
-        let (o, r) = tessellate_object(object, mode)?;
+        let budget = Budget {
+            object: &object.name,
+            triangles: MAX_TRIANGLES.saturating_sub(report.triangles),
+        };
+        let (o, r, b) = object_within(object, mode, budget, patch_done)?;
         report.add(&r);
         objects.push(o);
+        boundaries.extend(b);
     }
+    report.trim_gaps = gaps::measure(&boundaries);
     Ok((
         Scene {
             objects,
@@ -129,18 +173,67 @@ pub fn tessellate_scene(
     ))
 }
 
-/// One object's tessellation (a mesh object is returned unchanged).
+/// One object's tessellation (a mesh object is returned unchanged). Its untrimmed surfaces
+/// become one welded, crack-free mesh as by [`tessellate_patches`]; each trimmed surface
+/// is appended as its own piece ([`trimmed`]).
 pub fn tessellate_object(
     object: &Object,
     mode: TessellationMode,
 ) -> Result<(Object, TessellationReport), TessellateError> {
+    let budget = Budget {
+        object: &object.name,
+        triangles: MAX_TRIANGLES,
+    };
+    let (object, mut report, boundaries) = object_within(object, mode, budget, &mut || {})?;
+    report.trim_gaps = gaps::measure(&boundaries);
+    Ok((object, report))
+}
+
+/// A trimmed face's boundary polylines in space.
+type FaceBoundary = Vec<Vec<DVec3>>;
+
+/// How many more triangles a tessellation may make, and the object named when it would
+/// make more.
+#[derive(Clone, Copy)]
+struct Budget<'a> {
+    object: &'a str,
+    triangles: u64,
+}
+
+/// [`tessellate_object`] within `budget`, without the gap measure, with the boundaries of
+/// its trimmed faces.
+fn object_within(
+    object: &Object,
+    mode: TessellationMode,
+    budget: Budget,
+    patch_done: &mut dyn FnMut(),
+) -> Result<(Object, TessellationReport, Vec<FaceBoundary>), TessellateError> {
+    let mut boundaries = Vec::new();
     let mesh = match &object.geometry {
         Geometry::Mesh(m) => m.clone(),
         Geometry::Surfaces(surfaces) => {
-            if surfaces.iter().any(|s| !s.trims.is_empty()) {
-                return Err(TessellateError::Trimmed(object.name.clone()));
+            let plan = Plan::new(mode)?;
+            let mut plain = Vec::new();
+            let mut trimmed = Vec::new();
+            for s in surfaces {
+                // Loops that fail to convert were refused at load; were one to get here, the
+                // surface is drawn untrimmed, as the renderer does.
+                match s.trim_region().ok().flatten() {
+                    Some(region) => trimmed.push((s, region)),
+                    None => match &s.geometry {
+                        SurfaceGeometry::Bezier(p) => plain.push(p.clone()),
+                        SurfaceGeometry::Nurbs(n) => plain.extend(n.to_bezier_patches()),
+                    },
+                }
             }
-            tessellate_patches(&object.bezier_patches(), mode)?.mesh
+            let mut mesh = patches_within(&plain, mode, budget, patch_done)?.mesh;
+            for (s, region) in trimmed {
+                let face = trimmed::tessellate_trimmed(s, &region, plan)?;
+                append(&mut mesh, face.mesh)?;
+                boundaries.push(face.boundary);
+                patch_done();
+            }
+            mesh
         }
         Geometry::Subdivision(_) => tessellate_patches(&object.bezier_patches(), mode)?.mesh,
     };
@@ -151,7 +244,21 @@ pub fn tessellate_object(
             ..object.clone()
         },
         report,
+        boundaries,
     ))
+}
+
+/// Appends `part` to `mesh`, renumbering its vertices.
+fn append(mesh: &mut TriangleMesh, part: TriangleMesh) -> Result<(), TessellateError> {
+    if mesh.positions.len() + part.positions.len() >= u32::MAX as usize {
+        return Err(TessellateError::TooManyVertices);
+    }
+    let base = mesh.positions.len() as u32;
+    mesh.positions.extend(part.positions);
+    mesh.normals.extend(part.normals);
+    mesh.indices
+        .extend(part.indices.into_iter().map(|t| t.map(|i| i + base)));
+    Ok(())
 }
 
 /// Tessellates patches into one welded, crack-free mesh, keeping each vertex's (u, v).
@@ -159,10 +266,24 @@ pub fn tessellate_patches(
     patches: &[BezierPatch],
     mode: TessellationMode,
 ) -> Result<PatchMesh, TessellateError> {
+    let budget = Budget {
+        object: "",
+        triangles: MAX_TRIANGLES,
+    };
+    patches_within(patches, mode, budget, &mut || {})
+}
+
+fn patches_within(
+    patches: &[BezierPatch],
+    mode: TessellationMode,
+    budget: Budget,
+    patch_done: &mut dyn FnMut(),
+) -> Result<PatchMesh, TessellateError> {
     let plan = Plan::new(mode)?;
     let mut t = Tessellator::default();
     for (index, patch) in patches.iter().enumerate() {
-        t.patch(index as u32, patch, plan)?;
+        t.patch(index as u32, patch, plan, budget)?;
+        patch_done();
     }
     Ok(t.out)
 }
@@ -203,6 +324,29 @@ impl Plan {
     }
 }
 
+impl Plan {
+    /// The grid `(g_u, g_v)` of a patch and the segments wanted on each side (in
+    /// [`Side::ALL`] order): the plan's grid, or in adaptive mode each side's own count and
+    /// the grid fine enough for the opposite sides and the mid-parameter curves.
+    fn grid(self, patch: &BezierPatch, curves: &[EdgeCurve; 4]) -> (usize, usize, [usize; 4]) {
+        match self {
+            Plan::Uniform { grid_u, grid_v } => (grid_u, grid_v, [grid_u, grid_v, grid_u, grid_v]),
+            Plan::Adaptive { tolerance } => {
+                let wanted = curves.each_ref().map(|c| c.adaptive_segments(tolerance));
+                let mid_u =
+                    segments_for_tolerance(&|t| patch.eval(t, 0.5), patch.degree_u(), tolerance);
+                let mid_v =
+                    segments_for_tolerance(&|t| patch.eval(0.5, t), patch.degree_v(), tolerance);
+                (
+                    wanted[0].max(wanted[2]).max(mid_u),
+                    wanted[1].max(wanted[3]).max(mid_v),
+                    wanted,
+                )
+            }
+        }
+    }
+}
+
 /// The grid `(g_u, g_v)` for `n` triangles per patch; see
 /// [`TessellationMode::TrianglesPerPatch`].
 pub fn grid_for_triangles(n: u32) -> Result<(u32, u32), TessellateError> {
@@ -233,23 +377,10 @@ impl Tessellator {
         index: u32,
         patch: &BezierPatch,
         plan: Plan,
+        budget: Budget,
     ) -> Result<(), TessellateError> {
         let curves = Side::ALL.map(|s| EdgeCurve::of(patch, s));
-        let (mut grid_u, mut grid_v, wanted) = match plan {
-            Plan::Uniform { grid_u, grid_v } => (grid_u, grid_v, [grid_u, grid_v, grid_u, grid_v]),
-            Plan::Adaptive { tolerance } => {
-                let wanted = curves.each_ref().map(|c| c.adaptive_segments(tolerance));
-                let mid_u =
-                    segments_for_tolerance(&|t| patch.eval(t, 0.5), patch.degree_u(), tolerance);
-                let mid_v =
-                    segments_for_tolerance(&|t| patch.eval(0.5, t), patch.degree_v(), tolerance);
-                (
-                    wanted[0].max(wanted[2]).max(mid_u),
-                    wanted[1].max(wanted[3]).max(mid_v),
-                    wanted,
-                )
-            }
-        };
+        let (mut grid_u, mut grid_v, wanted) = plan.grid(patch, &curves);
         let mut sides: [Vec<u32>; 4] = Default::default();
         for (k, side) in Side::ALL.into_iter().enumerate() {
             sides[k] = self.side_vertices(index, patch, side, &curves[k], wanted[k])?;
@@ -258,6 +389,17 @@ impl Tessellator {
             // The ring stitch needs at least one interior grid point.
             grid_u = grid_u.max(2);
             grid_v = grid_v.max(2);
+        }
+        // Checked before the grid is made: the interior grid alone is (g_u + 1)(g_v + 1)
+        // vertices, so an absurd grid must be refused before its allocation.
+        let triangles = self.out.mesh.indices.len() as u64 + 2 * grid_u as u64 * grid_v as u64;
+        if triangles > budget.triangles {
+            return Err(TessellateError::Budget {
+                object: budget.object.to_string(),
+                patch: index,
+                triangles: triangles + (MAX_TRIANGLES - budget.triangles),
+                budget: MAX_TRIANGLES,
+            });
         }
         let mut interior = vec![0u32; (grid_u + 1) * (grid_v + 1)];
         for j in 1..grid_v {

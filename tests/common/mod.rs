@@ -45,3 +45,29 @@ pub fn render(scene: &Path, out: &Path, (width, height): (u32, u32), extra: &[&s
     args.extend_from_slice(extra);
     run(&args)
 }
+
+/// `patchtrace trace SCENE --rays FILE EXTRA...` on the ray text `rays`: the CSV rows
+/// after the contract header (checked), split at commas.
+pub fn trace_rows(scene: &Path, rays: &str, extra: &[&str]) -> Vec<Vec<String>> {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("rays.txt");
+    std::fs::write(&file, rays).unwrap();
+    let mut args = vec![
+        "trace",
+        scene.to_str().unwrap(),
+        "--rays",
+        file.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let o = run(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    let mut lines = out.lines();
+    assert_eq!(
+        lines.next(),
+        Some("ray,hit,t,object,patch,u,v,px,py,pz,nx,ny,nz")
+    );
+    lines
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect()
+}

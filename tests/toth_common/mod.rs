@@ -88,7 +88,7 @@ pub fn agrees_with_reference(
         for _ in 0..rays_per_patch {
             let (ray, o, d) = random_ray(&mut rng);
             rays += 1;
-            let want = intersect_f64(&patch, o, d, 0.0, f64::INFINITY, &reference);
+            let want = intersect_f64(&patch, o, d, 0.0, f64::INFINITY, &reference, None);
             let got = kernel(&patch, &ray);
             match (want, got) {
                 (Some(w), Some(g)) => {

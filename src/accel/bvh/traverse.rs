@@ -113,14 +113,24 @@ impl Bvh {
         F: FnMut(std::ops::Range<usize>, &mut f32) -> ControlFlow<()>,
     {
         let mut stats = TraversalStats::default();
-        if self.wide.is_empty() {
+        // The stack bound below rests on unused lanes (empty boxes) never being entered,
+        // which holds only for a finite origin and direction: from an infinite origin every
+        // plane is at t = +inf (or NaN), so `enter <= exit` holds in every lane, the unused
+        // lanes' child (index 0, the root) is pushed again and again, and the stack
+        // overflows (issue 21: origin 4e38 rounds to inf in f32). With finite values an
+        // empty lane's near plane is +inf and its far plane -inf on every axis (the
+        // reciprocal of a finite direction is never 0), so it is never entered. Such a ray
+        // meets nothing the kernels could represent anyway.
+        if self.wide.is_empty() || !(ray.origin.is_finite() && ray.dir.is_finite()) {
             return stats;
         }
         let wray = WideRay::new(ray);
         let tmin = ray.tmin;
         let mut tmax = ray.tmax;
-        // Each wide level pushes at most WIDTH - 1 entries and the wide tree is no deeper
-        // than the binary one, which the builder and `validate` keep below MAX_DEPTH. Left
+        // Each wide level pushes at most WIDTH - 1 entries, and what is on the stack was
+        // pushed by ancestors of the current node (a popped entry's siblings and the
+        // entries below them were); the wide tree is no deeper than the binary one, which
+        // the builder and `validate` keep below MAX_DEPTH. Left
         // uninitialised: zeroing its 1.5 KB was two thirds of the instructions per ray
         // (callgrind, BENCHMARKS.md issue 4).
         let mut stack = [MaybeUninit::<(Child, f32)>::uninit(); (WIDTH - 1) * MAX_DEPTH];

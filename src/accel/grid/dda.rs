@@ -61,7 +61,11 @@ impl Dda {
             inv_dir,
             lo: grid.lo,
             edge: grid.edge,
-            done: span.is_none() || grid.cells.cell_count() == 0,
+            // A non-finite origin or direction gives NaN crossing times, which would step
+            // an axis the ray does not move along forever.
+            done: span.is_none()
+                || grid.cells.cell_count() == 0
+                || !(origin.is_finite() && dir.is_finite()),
         };
         for a in 0..3 {
             let c = ((entry[a] - grid.lo[a]) / grid.edge).floor();

@@ -142,37 +142,51 @@ impl Grid {
         pad: f64,
         limit: usize,
     ) -> bool {
-        // Each registration keeps one u32 in the final table, so more than limit / 4 of
-        // them can never fit.
-        let max_pairs = limit / 4;
+        // The list of (voxel, primitive) pairs is the peak of the build (16 bytes a pair,
+        // the final table keeps 4), so the budget counts it: at 4 bytes a pair a mutated
+        // scene took four times its budget (issue 21: 1 GB for the default 256 MiB).
+        let max_pairs = limit / size_of::<(u64, u32)>();
         let mut pairs: Vec<(u64, u32)> = Vec::new();
         let target = self.edge / K;
         for (prim, patch) in patches.iter().enumerate() {
+            let mut fits = true;
             let tight = register::quarter_boxes(patch, target, &mut |b| {
-                self.push_voxels(b, pad, prim as u32, &mut pairs);
-                pairs.len() <= max_pairs
+                fits = self.push_voxels(b, pad, prim as u32, &mut pairs, max_pairs);
+                fits
             });
-            if pairs.len() > max_pairs {
+            if !fits {
                 return false;
             }
             self.boxes.push(widen(&tight, pad).to_f32_outward());
         }
         for (k, b) in triangles.iter().enumerate() {
-            self.push_voxels(b, pad, (patches.len() + k) as u32, &mut pairs);
+            if !self.push_voxels(b, pad, (patches.len() + k) as u32, &mut pairs, max_pairs) {
+                return false;
+            }
             self.boxes.push(widen(b, pad).to_f32_outward());
-        }
-        if pairs.len() > max_pairs {
-            return false;
         }
         self.cells = CellTable::from_pairs(pairs);
         self.memory_bytes() <= limit
     }
 
-    /// Appends `(voxel, prim)` for every voxel the widened box overlaps.
-    fn push_voxels(&self, b: &DAabb, pad: f64, prim: u32, pairs: &mut Vec<(u64, u32)>) {
+    /// Appends `(voxel, prim)` for every voxel the widened box overlaps, unless that would
+    /// make more than `max_pairs` pairs in all (`false`, nothing appended): one huge box
+    /// among tiny ones could otherwise cover 2^48 voxels before any check.
+    fn push_voxels(
+        &self,
+        b: &DAabb,
+        pad: f64,
+        prim: u32,
+        pairs: &mut Vec<(u64, u32)>,
+        max_pairs: usize,
+    ) -> bool {
         let b = widen(b, pad);
         let lo = self.cell_of(b.min);
         let hi = self.cell_of(b.max);
+        let count: u64 = (0..3).map(|a| u64::from(hi[a] - lo[a]) + 1).product();
+        if pairs.len() as u64 + count > max_pairs as u64 {
+            return false;
+        }
         for z in lo[2]..=hi[2] {
             for y in lo[1]..=hi[1] {
                 for x in lo[0]..=hi[0] {
@@ -180,6 +194,7 @@ impl Grid {
                 }
             }
         }
+        true
     }
 
     /// The voxel holding point `p`, clamped into the grid.

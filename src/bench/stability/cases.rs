@@ -7,9 +7,10 @@
 use std::f64::consts::{FRAC_PI_2, TAU};
 use std::path::Path;
 
-use glam::{DAffine3, DQuat, DVec3, Vec3};
+use glam::{DAffine3, DQuat, DVec2, DVec3, Vec3};
 
 use crate::geom::nurbs::shapes::sphere;
+use crate::geom::trim::{ParamCurve, TrimLoop};
 use crate::geom::ulp::step_ulps;
 use crate::geom::{BezierPatch, Ray};
 use crate::scene::bpt::parse_bpt;
@@ -62,6 +63,16 @@ const SILHOUETTE_ULPS: i32 = 4;
 /// Weights of the rational case span this range (issue 7).
 const WEIGHT_MIN: f64 = 1e-3;
 const WEIGHT_MAX: f64 = 1e3;
+/// Scale and offset of the plates with a round hole (issue 15: scales 1e-3, 1, 1e3 and an
+/// offset of 1e4).
+const HOLED_PLATES: [(f64, f64); 4] = [(1e-3, 0.0), (1.0, 0.0), (1e3, 0.0), (1.0, 1e4)];
+/// The hole's radius in the plate's [0,1]² parameters, about its centre.
+const HOLE_RADIUS: f64 = 0.3;
+/// Rays aimed beside the hole pass within this range of parameter distances from its
+/// circle, log-uniformly, on both sides: from about the final box's parameter extent at
+/// the plate with the largest coordinates (1e4 + 1: an f32 ulp of 1e-3) to 1e-2.
+const HOLE_DISTANCE_MIN: f64 = 1e-5;
+const HOLE_DISTANCE_MAX: f64 = 1e-2;
 /// Size ratio of the tiny and the huge patch (issue 7).
 const TINY_HUGE_RATIO: f64 = 1e6;
 /// A scale that puts the teapot's control points at ~1e-40, below `f32::MIN_POSITIVE`
@@ -165,6 +176,20 @@ pub fn all_cases(size: SuiteSize, seed: u64) -> Vec<Case> {
         &p,
         random_rays(&p, n, &mut rng),
     ));
+    for (scale, offset) in HOLED_PLATES {
+        let p = plate(scale, offset);
+        cases.push(holed_case(
+            &format!("round hole x{scale:e} at {offset:e}"),
+            &p,
+            hole_rays(&p, n, &mut rng),
+        ));
+    }
+    let p = plate(1.0, 0.0);
+    cases.push(holed_case(
+        "grazing along a trim curve",
+        &p,
+        trim_grazing_rays(&p, n, &mut rng),
+    ));
     for s in [NEAR_SUBNORMAL_SCALE, SUBNORMAL_SCALE] {
         let p = transformed(&teapot, DAffine3::from_scale(DVec3::splat(s)));
         cases.push(case(
@@ -183,6 +208,23 @@ fn case(name: &str, patches: &[BezierPatch], rays: Vec<Ray>) -> Case {
         .iter()
         .map(|p| Surface::bezier(round_to_f32(p)))
         .collect();
+    case_of_surfaces(name, surfaces, rays)
+}
+
+/// A case of `plate` with a round hole of [`HOLE_RADIUS`] about its parameter centre, the
+/// patch rounded to `f32` like [`case`]'s.
+fn holed_case(name: &str, plate: &BezierPatch, rays: Vec<Ray>) -> Case {
+    let surface = Surface {
+        trims: vec![TrimLoop::closed(
+            ParamCurve::circle(DVec2::splat(0.5), HOLE_RADIUS),
+            true,
+        )],
+        ..Surface::bezier(round_to_f32(plate))
+    };
+    case_of_surfaces(name, vec![surface], rays)
+}
+
+fn case_of_surfaces(name: &str, surfaces: Vec<Surface>, rays: Vec<Ray>) -> Case {
     let mut scene = Scene::framing(vec![Object {
         name: name.to_string(),
         material: 0,
@@ -347,6 +389,53 @@ fn tiny_beside_huge() -> Vec<BezierPatch> {
 // ---------------------------------------------------------------------------------------
 
 /// Centre and radius of the patches' control boxes.
+/// The plate z = 0 over `offset + scale · [0,1]²`, a bicubic patch with a linear
+/// parameterisation.
+fn plate(scale: f64, offset: f64) -> BezierPatch {
+    net(3, 3, |u, v| {
+        DVec3::new(offset + scale * u, offset + scale * v, 0.0)
+    })
+}
+
+/// The point of `plate` at parameter distance `rho` from its centre at `angle`.
+fn around_centre(plate: &BezierPatch, rho: f64, angle: f64) -> DVec3 {
+    plate.eval(0.5 + rho * angle.cos(), 0.5 + rho * angle.sin())
+}
+
+/// Rays from random directions of the upper half-space through points at log-uniform
+/// parameter distances from the hole's circle, inside and outside it.
+fn hole_rays(plate: &BezierPatch, n: usize, rng: &mut SplitMix64) -> Vec<Ray> {
+    let (lo, hi) = (HOLE_DISTANCE_MIN.ln(), HOLE_DISTANCE_MAX.ln());
+    let (_, radius) = extent(std::slice::from_ref(plate));
+    (0..n)
+        .map(|i| {
+            let side = if i % 2 == 0 { 1.0 } else { -1.0 };
+            let rho = HOLE_RADIUS + side * rng.range(lo, hi).exp();
+            let target = around_centre(plate, rho, rng.range(0.0, TAU));
+            let mut dir = rng.direction();
+            dir.z = -dir.z.abs().max(0.05);
+            aimed(target, dir, 3.0 * radius)
+        })
+        .collect()
+}
+
+/// Rays at 1e-6..1e-1 rad to the plate, crossing it near the hole's circle while running
+/// along its tangent there: they graze the surface and the trim curve at once.
+fn trim_grazing_rays(plate: &BezierPatch, n: usize, rng: &mut SplitMix64) -> Vec<Ray> {
+    let (lo, hi) = (GRAZING_MIN.ln(), GRAZING_MAX.ln());
+    (0..n)
+        .map(|i| {
+            let angle = rng.range(0.0, TAU);
+            let side = if i % 2 == 0 { 1.0 } else { -1.0 };
+            let target = around_centre(plate, HOLE_RADIUS * (1.0 + side * 1e-3), angle);
+            let tangent = DVec3::new(-angle.sin(), angle.cos(), 0.0);
+            let a = rng.range(lo, hi).exp();
+            let dir = tangent * a.cos() - DVec3::Z * a.sin();
+            aimed(target, dir, 0.5)
+        })
+        .collect()
+}
+
 fn extent(patches: &[BezierPatch]) -> (DVec3, f64) {
     let b = patches.iter().fold(crate::geom::DAabb::EMPTY, |acc, p| {
         acc.union(&p.control_box())

@@ -93,6 +93,20 @@ impl Frame {
     pub fn point(&self, a: f64, b: f64, c: f64) -> DVec3 {
         self.origin + self.x * a + self.y * b + self.z * c
     }
+
+    /// The frame coordinates of the world point `p` (the inverse of [`Frame::point`]).
+    pub fn local(&self, p: DVec3) -> DVec3 {
+        let d = p - self.origin;
+        DVec3::new(d.dot(self.x), d.dot(self.y), d.dot(self.z))
+    }
+
+    /// The affine map from frame coordinates to world coordinates.
+    pub fn to_affine(&self) -> glam::DAffine3 {
+        glam::DAffine3::from_mat3_translation(
+            glam::DMat3::from_cols(self.x, self.y, self.z),
+            self.origin,
+        )
+    }
 }
 
 fn unit(v: DVec3, name: &'static str) -> Result<DVec3, ShapeError> {

@@ -11,7 +11,7 @@ use glam::DVec4;
 use super::curve::NurbsCurve;
 use super::knots::{self, KnotError};
 use super::surface::{NurbsSurface, knot_error};
-use crate::geom::bezier::GeomError;
+use crate::geom::bezier::{GeomError, ParamRect};
 
 impl NurbsCurve {
     /// Inserts `t` `times` times. `t` must lie in the domain and its multiplicity must
@@ -69,12 +69,20 @@ impl NurbsCurve {
     /// are dropped, and the outermost remaining knot is set to the end (the basis function
     /// left at each end does not depend on it, A2.2's recurrence).
     pub fn clamped(&self) -> NurbsCurve {
+        let (start, end) = knots::domain(self.degree, &self.knots);
+        self.clamped_to(start, end)
+    }
+
+    /// The curve restricted to `[start, end]` (inside its domain, `start < end`), with
+    /// clamped knots: each end is inserted until its multiplicity is the degree, and the
+    /// control points and knots beyond it are dropped, as [`NurbsCurve::clamped`] does at
+    /// the domain's ends. The curve does not move on `[start, end]`.
+    pub fn clamped_to(&self, start: f64, end: f64) -> NurbsCurve {
         let p = self.degree;
-        let (start, end) = knots::domain(p, &self.knots);
         let mut c = self.clone();
         if c.knots[0] != start {
             let s = knots::multiplicity(&c.knots, start);
-            c = c.insert_unchecked(start, p - s);
+            c = c.insert_unchecked(start, p.saturating_sub(s));
             let last = c.knots.partition_point(|&x| x <= start) - 1;
             let first = last - p;
             c.points.drain(..first);
@@ -83,7 +91,7 @@ impl NurbsCurve {
         }
         if c.knots[c.knots.len() - 1] != end {
             let s = knots::multiplicity(&c.knots, end);
-            c = c.insert_unchecked(end, p - s);
+            c = c.insert_unchecked(end, p.saturating_sub(s));
             let first = c.knots.partition_point(|&x| x < end);
             c.points.truncate(first);
             c.knots.truncate(first + p + 1);
@@ -109,6 +117,15 @@ impl NurbsSurface {
             .transposed()
             .map_rows_u(|row| row.insert_unchecked(t, times))
             .transposed())
+    }
+
+    /// The surface restricted to `rect` (inside its domain, non-empty), clamped: OBJ's
+    /// `surf s0 s1 t0 t1` range. Exact: knot insertion does not move the surface.
+    pub fn restricted(&self, rect: ParamRect) -> NurbsSurface {
+        self.map_rows_u(|row| row.clamped_to(rect.u0, rect.u1))
+            .transposed()
+            .map_rows_u(|row| row.clamped_to(rect.v0, rect.v1))
+            .transposed()
     }
 
     /// The same surface on the same domain with both knot vectors clamped.
@@ -157,6 +174,27 @@ mod tests {
             prop_assert_eq!(new_knots.len(), knots.len() + times);
             prop_assert_eq!(r.domain(), s.domain());
             let dev = max_deviation(&s, &r);
+            prop_assert!(dev <= 1e-12 * diagonal(&s), "deviation {}", dev);
+        }
+
+        #[test]
+        fn restriction_keeps_the_surface_on_the_sub_rectangle(
+            s in surface(),
+            a in 0.0..1.0f64,
+            b in 0.0..1.0f64,
+            c in 0.0..1.0f64,
+            e in 0.0..1.0f64,
+        ) {
+            let d = s.domain();
+            let (u0, u1) = d.to_parent(a.min(b), a.max(b));
+            let (v0, v1) = d.to_parent(c.min(e), c.max(e));
+            prop_assume!(u1 - u0 > 1e-3 * (d.u1 - d.u0) && v1 - v0 > 1e-3 * (d.v1 - d.v0));
+            let rect = ParamRect { u0, u1, v0, v1 };
+            let r = s.restricted(rect);
+            prop_assert!(r.validate().is_ok());
+            prop_assert_eq!(r.domain(), rect);
+            // Compared on the restricted domain: the same points as the original there.
+            let dev = max_deviation(&r, &s);
             prop_assert!(dev <= 1e-12 * diagonal(&s), "deviation {}", dev);
         }
 

@@ -10,11 +10,11 @@ use super::surface::NurbsSurface;
 use crate::geom::bezier::GeomError;
 
 /// Knots of the 9-point circle: four quadrants, each a Bézier arc.
-const CIRCLE_KNOTS: [f64; 12] = [0., 0., 0., 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1., 1., 1.];
+pub const CIRCLE_KNOTS: [f64; 12] = [0., 0., 0., 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1., 1., 1.];
 
 /// The 9-point unit circle around the z axis: Euclidean `(x, y)` and weight. The corner
 /// points of the square carry weight √2/2, which makes each quadrant an exact circular arc.
-fn circle() -> [(f64, f64, f64); 9] {
+pub fn circle() -> [(f64, f64, f64); 9] {
     let w = FRAC_1_SQRT_2;
     [
         (1., 0., 1.),

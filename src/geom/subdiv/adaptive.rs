@@ -231,11 +231,11 @@ fn hull_is_final(mesh: &Mesh, topo: &Topology, faces: &[u32]) -> bool {
             }
         }
     }
-    (0..3).all(|a| {
-        let (l, h) = (lo[a] as f32, hi[a] as f32);
-        let scale = l.abs().max(h.abs());
-        f64::from(h) - f64::from(l) <= DEFAULT_END_ULPS as f64 * ulp_of(scale)
-    })
+    // Ulps of the largest coordinate, as the kernel's end game measures a box: a hull at
+    // x = 0 is as precise as its largest coordinate allows, not as 0's ulp.
+    let scale = lo.abs().max(hi.abs()).max_element() as f32;
+    let allowance = DEFAULT_END_ULPS as f64 * ulp_of(scale);
+    (0..3).all(|a| f64::from(hi[a] as f32) - f64::from(lo[a] as f32) <= allowance)
 }
 
 /// The Bézier net of a regular face from its B-spline net, with the limit positions at

@@ -22,6 +22,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 pub use stats::CachedStats;
 
+use crate::geom::trim::PatchTrim;
 use crate::geom::{BezierPatch, Ray};
 use crate::kernel::toth::TothConfig;
 use crate::kernel::toth::search::Goal;
@@ -102,24 +103,26 @@ thread_local! {
 /// reports it; `origin` when `ray` leaves this patch (LG90 §6's triviality tests apply).
 pub fn intersect(
     patch: &BezierPatch,
+    trim: Option<&PatchTrim>,
     ray: &Ray,
     cfg: &CachedConfig,
     origin: bool,
     stats: &mut KernelStats,
 ) -> Option<PatchHit> {
-    run(patch, ray, cfg, Goal::Nearest, origin, stats)
+    run(patch, ray, cfg, (Goal::Nearest, trim), origin, stats)
 }
 
 /// True when the patch blocks `ray` in `[tmin, tmax]` (shadow rays; with `cfg.toth.isrt`
 /// the first safe region answers, LG90 §6); `origin` as for [`intersect`].
 pub fn occluded(
     patch: &BezierPatch,
+    trim: Option<&PatchTrim>,
     ray: &Ray,
     cfg: &CachedConfig,
     origin: bool,
     stats: &mut KernelStats,
 ) -> bool {
-    run(patch, ray, cfg, Goal::Any, origin, stats).is_some()
+    run(patch, ray, cfg, (Goal::Any, trim), origin, stats).is_some()
 }
 
 /// Bytes of surface trees the calling thread caches under `cfg` (0 when it has none).
@@ -137,7 +140,7 @@ fn run(
     patch: &BezierPatch,
     ray: &Ray,
     cfg: &CachedConfig,
-    goal: Goal,
+    (goal, trim): (Goal, Option<&PatchTrim>),
     origin: bool,
     stats: &mut KernelStats,
 ) -> Option<PatchHit> {
@@ -165,7 +168,7 @@ fn run(
             patch,
             ray,
             cfg,
-            (goal, origin),
+            (goal, origin, trim),
             &mut tree,
             &mut w.scratch,
             (&mut stats.toth, &mut stats.cached),

@@ -9,6 +9,7 @@
 use std::collections::BinaryHeap;
 
 use crate::geom::interval::IntervalNet;
+use crate::geom::trim::PatchTrim;
 use crate::geom::{BezierPatch, Ray};
 use crate::kernel::PatchHit;
 use crate::kernel::toth::TothStats;
@@ -45,7 +46,7 @@ pub fn search(
     patch: &BezierPatch,
     ray: &Ray,
     cfg: &CachedConfig,
-    (goal, origin): (Goal, bool),
+    (goal, origin, trim): (Goal, bool, Option<&PatchTrim>),
     tree: &mut SurfaceTree,
     s: &mut Scratch,
     (toth, cache): (&mut TothStats, &mut CachedStats),
@@ -159,7 +160,7 @@ pub fn search(
                 }
             }
         };
-        if let Some(h) = hit {
+        if let Some(h) = hit.filter(|h| search::kept(trim, h)) {
             if goal == Goal::Any {
                 return Some(h);
             }

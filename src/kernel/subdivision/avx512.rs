@@ -27,14 +27,13 @@
 use std::arch::x86_64::*;
 
 use super::bicubic::Net;
-use super::config::Termination;
 use super::float::{GBox, GRay, KernelFloat};
 use super::heuristics::Corners;
 use super::jump::{Jump, JumpOutcome, Linearization, plan, restriction};
 use super::param::{ParamCell, Split};
-use super::ray_space::{MIN_RAY_SPACE_SCALE, RayFrame};
+use super::ray_space::{MIN_RAY_SPACE_SCALE, RayFrame, SpacedHit};
 use super::register::{ChildTests, Query, RegisterNet, RegisterStack, Scratch};
-use super::search::{SearchHit, end_game_diameter, search};
+use super::search::{end_game_diameter, search};
 use crate::geom::bbox::SLAB_FAR_SCALE;
 use crate::kernel::KernelStats;
 
@@ -528,7 +527,8 @@ impl RegisterNet for Net16 {
     }
 }
 
-/// The search of [`super::search`] on the AVX-512 net.
+/// The search of [`super::search`] on the AVX-512 net, in the ray space of the query's
+/// frame where it has one (the hit's box then stays in ray space, see [`SpacedHit`]).
 ///
 /// # Panics
 /// Never on a CPU where [`available`] is true; callers check it first.
@@ -537,7 +537,7 @@ pub fn search_net16(
     scratch: &mut Scratch<Net16>,
     q: Query,
     stats: &mut KernelStats,
-) -> Option<SearchHit<f32>> {
+) -> Option<SpacedHit> {
     assert!(available(), "the AVX-512 kernel path needs AVX-512F");
     // SAFETY: the CPU has AVX-512F (asserted above).
     unsafe { search_avx512(net, scratch, q, stats) }
@@ -550,15 +550,16 @@ fn search_avx512(
     Query {
         root,
         ray,
+        frame,
         cfg,
         any_hit,
+        trim,
     }: Query,
     stats: &mut KernelStats,
-) -> Option<SearchHit<f32>> {
+) -> Option<SpacedHit> {
     let world = Net16::from_net(net);
-    if cfg.ray_space && cfg.termination == Termination::Float {
-        let frame = RayFrame::new(ray);
-        let local = world.in_ray_space(&frame);
+    if let Some(frame) = frame {
+        let local = world.in_ray_space(frame);
         let local_root = local.bounds();
         let scale = (0..3).fold(0f32, |a, i| {
             a.max(-local_root.min[i]).max(local_root.max[i])
@@ -575,20 +576,19 @@ fn search_avx512(
             let floor = frame.world_length(end_game_diameter(&root, cfg.end_ulps));
             let mut nets = RegisterStack::with_registers(local, registers, floor, slots);
             let hit = search(
-                &mut nets, nodes, local_root, &axis, false, cfg, any_hit, stats,
+                &mut nets, nodes, local_root, &axis, false, cfg, any_hit, trim, stats,
             )?;
-            if any_hit {
-                // `occluded` needs no hit box.
-                return Some(hit);
-            }
-            return Some(SearchHit {
-                bbox: frame.world_box(&hit.bbox, scale),
-                ..hit
+            return Some(SpacedHit {
+                hit,
+                ray_space_scale: Some(scale),
             });
         }
     }
     let mut nets = RegisterStack::new(world, ray, slots);
-    search(&mut nets, nodes, root, ray, false, cfg, any_hit, stats)
+    search(
+        &mut nets, nodes, root, ray, false, cfg, any_hit, trim, stats,
+    )
+    .map(SpacedHit::world)
 }
 
 #[cfg(test)]
@@ -598,6 +598,7 @@ mod tests {
     use crate::kernel::subdivision::bicubic::tests::patch;
     use crate::kernel::subdivision::jump::halve;
     use crate::kernel::subdivision::register::{LaneNet, search_register};
+    use crate::kernel::subdivision::search::SearchHit;
 
     /// Random rays from above aimed at the patch's neighbourhood, by a fixed xorshift32.
     fn rays() -> Vec<GRay<f32>> {
@@ -651,13 +652,16 @@ mod tests {
                 let q = Query {
                     root,
                     ray: &ray,
+                    frame: None,
                     cfg: &cfg,
                     any_hit,
+                    trim: None,
                 };
                 let a = search_net16(&net, &mut scratch16, q, &mut s16);
+                assert!(a.is_none_or(|h| h.ray_space_scale.is_none()));
                 let b = search_register(net, &mut scratch, q, &mut s);
                 assert_eq!(
-                    a.map(|h| (h.t, h.cell, h.bbox)),
+                    a.map(|h| (h.hit.t, h.hit.cell, h.hit.bbox)),
                     b.map(|h| (h.t, h.cell, h.bbox))
                 );
                 assert_eq!((s16.splits, s16.box_tests), (s.splits, s.box_tests));
@@ -673,23 +677,33 @@ mod tests {
     /// end game, and the two `t` differ by no more than the two final boxes' extents.
     #[test]
     fn ray_space_search_finds_the_world_space_hits() {
-        let Some((net, root, world_cfg)) = setup() else {
+        let Some((net, root, cfg)) = setup() else {
             return;
         };
-        let cfg = SubdivisionConfig::default();
         let (mut scratch, mut stats) = (Default::default(), KernelStats::default());
-        let mut search = |ray: &GRay<f32>, cfg: &SubdivisionConfig| {
+        // The hit with its box in world space.
+        let mut search = |ray: &GRay<f32>, frame: Option<&RayFrame>| {
             let q = Query {
                 root,
                 ray,
-                cfg,
+                frame,
+                cfg: &cfg,
                 any_hit: false,
+                trim: None,
             };
-            search_net16(&net, &mut scratch, q, &mut stats)
+            let h = search_net16(&net, &mut scratch, q, &mut stats)?;
+            Some(match (h.ray_space_scale, frame) {
+                (Some(scale), Some(frame)) => SearchHit {
+                    bbox: frame.world_box(&h.hit.bbox, scale),
+                    ..h.hit
+                },
+                _ => h.hit,
+            })
         };
         let mut hits = 0;
         for ray in rays() {
-            let (a, b) = (search(&ray, &cfg), search(&ray, &world_cfg));
+            let frame = RayFrame::new(&ray);
+            let (a, b) = (search(&ray, Some(&frame)), search(&ray, None));
             assert_eq!(a.is_some(), b.is_some(), "{ray:?}");
             let (Some(a), Some(b)) = (a, b) else { continue };
             hits += 1;

@@ -139,7 +139,7 @@ mod tests {
     #[test]
     fn hits_match_the_general_path_on_random_rays() {
         let p = patch();
-        let fast = PreparedPatch::new(&p);
+        let fast = PreparedPatch::bilinear(&p).expect("a bilinear patch");
         assert!(matches!(fast.data, Prepared::Bilinear(_)));
         let general = PreparedPatch::general(&p);
         let cfg = SubdivisionConfig::default();
@@ -154,12 +154,12 @@ mod tests {
             let origin = Vec3::new(8.0 * r() - 4.0, 6.0 + 4.0 * r(), 8.0 * r() - 4.0);
             let ray = Ray::new(origin, target - origin);
             let mut stats = KernelStats::default();
-            let a = intersect(&fast, &ray, &cfg, &mut stats);
-            let b = intersect(&general, &ray, &cfg, &mut stats);
+            let a = intersect(&fast, None, &ray, &cfg, &mut stats);
+            let b = intersect(&general, None, &ray, &cfg, &mut stats);
             assert_eq!(a, b, "ray {ray:?}");
             assert_eq!(
-                occluded(&fast, &ray, &cfg, &mut stats),
-                occluded(&general, &ray, &cfg, &mut stats)
+                occluded(&fast, None, &ray, &cfg, &mut stats),
+                occluded(&general, None, &ray, &cfg, &mut stats)
             );
             if let Some(h) = a {
                 // The final box contains the point of the surface the ray was aimed at

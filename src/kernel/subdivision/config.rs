@@ -121,9 +121,8 @@ pub struct SubdivisionConfig {
     pub end_ulps: u32,
     /// Search bicubic patches in the ray's own frame ([`super::ray_space`]) where the
     /// fast path supports it. A property of the ray, so that every patch a ray meets is
-    /// searched in the same space: on for primary rays, off for secondary rays
-    /// ([`SubdivisionConfig::for_secondary_rays`]), whose origins are corners of
-    /// world-space hit boxes (Dammertz §2.4).
+    /// searched in the same space; on by default for primary and secondary rays alike
+    /// (each ray has its own frame, from its own origin and direction).
     pub ray_space: bool,
     /// The work budget: after this many splits of one ray–patch test the end game doubles
     /// every [`COARSEN_STEP_SPLITS`] splits, so a test takes at most this plus
@@ -150,8 +149,9 @@ impl Default for SubdivisionConfig {
 impl SubdivisionConfig {
     /// The configuration for secondary rays: adaptive termination is defined by the
     /// camera's pixels and so only for primary rays (§2.5.3, "this simple projection does
-    /// not work for secondary rays"); they fall back to float precision. They search in
-    /// world space (see [`SubdivisionConfig::ray_space`]).
+    /// not work for secondary rays"); they fall back to float precision. The search space
+    /// ([`SubdivisionConfig::ray_space`]) stays the primary rays': a secondary ray's frame
+    /// is built from its own origin and direction like a primary ray's.
     pub fn for_secondary_rays(self) -> SubdivisionConfig {
         let termination = match self.termination {
             Termination::Adaptive(_) => Termination::Float,
@@ -159,7 +159,6 @@ impl SubdivisionConfig {
         };
         SubdivisionConfig {
             termination,
-            ray_space: false,
             ..self
         }
     }
@@ -190,6 +189,6 @@ mod tests {
             ..SubdivisionConfig::default()
         };
         assert_eq!(depth.for_secondary_rays().termination, depth.termination);
-        assert!(depth.ray_space && !depth.for_secondary_rays().ray_space);
+        assert!(depth.ray_space && depth.for_secondary_rays().ray_space);
     }
 }

@@ -47,7 +47,7 @@
 //! hit and miss to agree with `f64` only away from a few ulps of the silhouette); at a
 //! fold silhouette `J₀` is near singular and no jump is tried.
 
-use super::param::ParamCell;
+use super::param::{ParamCell, dyadic_width};
 
 /// Largest Lipschitz bound `q` at which a jump is tried: the window grows as `q / (1 − q)`,
 /// so above 1/2 it is wider than the step itself and saves little.
@@ -139,7 +139,7 @@ impl Jump {
 /// either net's rounding can move it ([`ROUNDING_ULPS`]), and the search never needs the
 /// sub-cell's neighbours.
 pub fn restriction(levels: u8, index: u64) -> [[f32; 4]; 4] {
-    let width = (-f64::from(levels)).exp2();
+    let width = dyadic_width(levels);
     let a = index as f64 * width;
     let b = a + width;
     let (s, t) = (1.0 - a, 1.0 - b);

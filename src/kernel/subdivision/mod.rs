@@ -49,9 +49,11 @@ use bilinear::BilinearNet;
 use float::{GBox, GRay};
 use general::{GeneralStack, Scratch};
 use prepared::Prepared;
+use ray_space::{RayFrame, SpacedHit};
 use register::{Query, search_register};
-use search::{SearchHit, search};
+use search::search;
 
+use crate::geom::trim::PatchTrim;
 use crate::geom::ulp::ulp_of;
 use crate::geom::{Aabb, Ray};
 use crate::kernel::{KernelStats, PatchHit};
@@ -83,22 +85,91 @@ thread_local! {
 /// the scale; 2 ulps leaves five times that room.
 pub const NET_ROUNDING_ULPS: f64 = 2.0;
 
+/// A ray in the form the kernel takes it, made once per ray for every patch it is tested
+/// against: the reciprocal direction and, for a search in ray space ([`ray_space`]), the
+/// frame, which depend on the ray alone.
+#[derive(Clone, Copy, Debug)]
+pub struct KernelRay {
+    ray: GRay<f32>,
+    frame: Option<RayFrame>,
+}
+
+impl KernelRay {
+    /// `ray` for searches with `cfg`: with a frame when `cfg` searches in ray space (which
+    /// needs the float-precision criterion, whose end game the frame's floor applies to).
+    pub fn new(ray: &Ray, cfg: &SubdivisionConfig) -> KernelRay {
+        let ray = GRay::new(
+            ray.origin.to_array(),
+            ray.dir.to_array(),
+            ray.tmin,
+            ray.tmax,
+        );
+        let in_ray_space = cfg.ray_space && cfg.termination == Termination::Float;
+        KernelRay {
+            frame: in_ray_space.then(|| RayFrame::new(&ray)),
+            ray,
+        }
+    }
+
+    /// The world box of `hit`'s final box (see [`SpacedHit`]).
+    pub fn hit_box(&self, hit: &KernelHit) -> Aabb {
+        match (hit.0.ray_space_scale, &self.frame) {
+            (Some(scale), Some(frame)) => frame.world_box(&hit.0.hit.bbox, scale).to_aabb(),
+            _ => hit.0.hit.bbox.to_aabb(),
+        }
+    }
+
+    /// The [`PatchHit`] of `hit`, world box included.
+    pub fn patch_hit(&self, hit: &KernelHit) -> PatchHit {
+        let (u, v) = hit.uv();
+        PatchHit {
+            t: hit.t(),
+            u: u as f32,
+            v: v as f32,
+            hit_box: self.hit_box(hit),
+        }
+    }
+}
+
+/// A hit of [`nearest`] whose box is still in the space the search ran in: its world box
+/// ([`KernelRay::hit_box`]) is made only for the ray's nearest hit.
+#[derive(Clone, Copy, Debug)]
+pub struct KernelHit(SpacedHit);
+
+impl KernelHit {
+    /// The ray parameter at the final box's entry.
+    pub fn t(&self) -> f32 {
+        self.0.hit.t
+    }
+
+    /// The centre of the final parameter cell (Dammertz code 2.3.8).
+    pub fn uv(&self) -> (f64, f64) {
+        self.0.hit.cell.centre()
+    }
+}
+
 /// Nearest hit with `t` in `[ray.tmin, ray.tmax]`; `ray.tmax` is the current closest hit.
 pub fn intersect(
     patch: &PreparedPatch,
+    trim: Option<&PatchTrim>,
     ray: &Ray,
     cfg: &SubdivisionConfig,
     stats: &mut KernelStats,
 ) -> Option<PatchHit> {
-    run(patch, ray, cfg, false, stats).map(|h| {
-        let (u, v) = h.cell.centre();
-        PatchHit {
-            t: h.t,
-            u: u as f32,
-            v: v as f32,
-            hit_box: h.bbox.to_aabb(),
-        }
-    })
+    let ray = KernelRay::new(ray, cfg);
+    nearest(patch, trim, &ray, ray.ray.tmax, cfg, stats).map(|h| ray.patch_hit(&h))
+}
+
+/// [`intersect`] for a ray made once for every patch it meets, with `t` up to `tmax`.
+pub fn nearest(
+    patch: &PreparedPatch,
+    trim: Option<&PatchTrim>,
+    ray: &KernelRay,
+    tmax: f32,
+    cfg: &SubdivisionConfig,
+    stats: &mut KernelStats,
+) -> Option<KernelHit> {
+    run(patch, trim, ray, tmax, cfg, false, stats).map(KernelHit)
 }
 
 /// `hit_box` grown on every side by [`NET_ROUNDING_ULPS`] ulps of the largest coordinate
@@ -113,44 +184,55 @@ pub fn widen_by_net_rounding(hit_box: Aabb, root: &Aabb) -> Aabb {
 /// Any hit in `[ray.tmin, ray.tmax]` (shadow rays): stops at the first final box found.
 pub fn occluded(
     patch: &PreparedPatch,
+    trim: Option<&PatchTrim>,
     ray: &Ray,
     cfg: &SubdivisionConfig,
     stats: &mut KernelStats,
 ) -> bool {
-    run(patch, ray, cfg, true, stats).is_some()
+    blocks(patch, trim, &KernelRay::new(ray, cfg), cfg, stats)
+}
+
+/// [`occluded`] for a ray made once for every patch it meets.
+pub fn blocks(
+    patch: &PreparedPatch,
+    trim: Option<&PatchTrim>,
+    ray: &KernelRay,
+    cfg: &SubdivisionConfig,
+    stats: &mut KernelStats,
+) -> bool {
+    run(patch, trim, ray, ray.ray.tmax, cfg, true, stats).is_some()
 }
 
 fn run(
     patch: &PreparedPatch,
-    ray: &Ray,
+    trim: Option<&PatchTrim>,
+    ray: &KernelRay,
+    tmax: f32,
     cfg: &SubdivisionConfig,
     any_hit: bool,
     stats: &mut KernelStats,
-) -> Option<SearchHit<f32>> {
-    let gray = GRay::new(
-        ray.origin.to_array(),
-        ray.dir.to_array(),
-        ray.tmin,
-        ray.tmax,
-    );
+) -> Option<SpacedHit> {
+    let gray = GRay { tmax, ..ray.ray };
     let root = GBox::from_aabb(patch.bounds);
     let query = Query {
         root,
         ray: &gray,
+        frame: ray.frame.as_ref(),
         cfg,
         any_hit,
+        trim,
     };
     match &patch.data {
         #[cfg(target_arch = "x86_64")]
         Prepared::Bicubic(net) if avx512::available() => {
             BICUBIC16_SCRATCH.with_borrow_mut(|s| avx512::search_net16(net, s, query, stats))
         }
-        Prepared::Bicubic(net) => {
-            BICUBIC_SCRATCH.with_borrow_mut(|s| search_register(*net, s, query, stats))
-        }
-        Prepared::Bilinear(net) => {
-            BILINEAR_SCRATCH.with_borrow_mut(|s| search_register(*net, s, query, stats))
-        }
+        Prepared::Bicubic(net) => BICUBIC_SCRATCH
+            .with_borrow_mut(|s| search_register(*net, s, query, stats))
+            .map(SpacedHit::world),
+        Prepared::Bilinear(net) => BILINEAR_SCRATCH
+            .with_borrow_mut(|s| search_register(*net, s, query, stats))
+            .map(SpacedHit::world),
         Prepared::General { net, shape } => GENERAL_SCRATCH.with_borrow_mut(|s| {
             let mut nets = GeneralStack::new(&mut s.nets, net, *shape);
             search(
@@ -161,8 +243,10 @@ fn run(
                 shape.rational,
                 cfg,
                 any_hit,
+                trim,
                 stats,
             )
+            .map(SpacedHit::world)
         }),
     }
 }

@@ -19,6 +19,13 @@ pub enum Split {
     V,
 }
 
+/// `2^-levels`, the width of a cell `levels` splits deep, exactly: built from its bits (any
+/// `u8` is far inside `f64`'s normal exponents) rather than by `exp2`, a library call that
+/// took 3% of the glass teapot's render in the jumps' restriction matrices.
+pub fn dyadic_width(levels: u8) -> f64 {
+    f64::from_bits((1023 - u64::from(levels)) << 52)
+}
+
 /// Fixed-point position of 1.0: the cell coordinates are multiples of 2^-63.
 const ONE_FIXED: f64 = (1u64 << 63) as f64;
 
@@ -86,8 +93,8 @@ impl ParamCell {
         (
             self.u0 as f64 / ONE_FIXED,
             self.v0 as f64 / ONE_FIXED,
-            (-(self.level_u as f64)).exp2(),
-            (-(self.level_v as f64)).exp2(),
+            dyadic_width(self.level_u),
+            dyadic_width(self.level_v),
         )
     }
 
@@ -112,6 +119,18 @@ mod tests {
         assert_eq!(ab.0, 0.5);
         assert_eq!(bb.0 + bb.2, 1.0);
         assert_eq!(a.centre(), (0.625, 0.25));
+    }
+
+    /// Against `exp2`, the library's power of two, for every width a `u8` names.
+    #[test]
+    fn dyadic_width_is_the_power_of_two() {
+        for levels in 0..=u8::MAX {
+            assert_eq!(
+                dyadic_width(levels),
+                (-f64::from(levels)).exp2(),
+                "{levels}"
+            );
+        }
     }
 
     #[test]

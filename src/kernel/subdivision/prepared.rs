@@ -31,13 +31,27 @@ impl PreparedPatch {
                 data: Prepared::Bicubic(net),
             };
         }
-        if let Some(net) = BilinearNet::from_patch(patch) {
+        #[cfg(target_arch = "x86_64")]
+        if super::avx512::available()
+            && let Some(net) = Net::elevated_bilinear(patch)
+        {
+            // Where the AVX-512 path runs, bilinear patches take it as bicubics, in ray
+            // space and with jumps (see `Net::elevated_bilinear`).
             return PreparedPatch {
                 bounds: net.bounds().to_aabb(),
-                data: Prepared::Bilinear(net),
+                data: Prepared::Bicubic(net),
             };
         }
-        PreparedPatch::general(patch)
+        PreparedPatch::bilinear(patch).unwrap_or_else(|| PreparedPatch::general(patch))
+    }
+
+    /// The bilinear fast path, for bilinear integral patches.
+    pub(crate) fn bilinear(patch: &BezierPatch) -> Option<PreparedPatch> {
+        let net = BilinearNet::from_patch(patch)?;
+        Some(PreparedPatch {
+            bounds: net.bounds().to_aabb(),
+            data: Prepared::Bilinear(net),
+        })
     }
 
     /// The general path for any patch (Dammertz §2.7.2), also the reference the fast paths

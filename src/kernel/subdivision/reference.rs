@@ -5,6 +5,8 @@
 
 use glam::DVec3;
 
+use crate::geom::trim::PatchTrim;
+
 use super::config::SubdivisionConfig;
 use super::float::GRay;
 use super::general::{GeneralStack, NetShape, Scratch, net_box};
@@ -29,6 +31,7 @@ pub fn intersect_f64(
     tmin: f64,
     tmax: f64,
     cfg: &SubdivisionConfig,
+    trim: Option<&PatchTrim>,
 ) -> Option<PatchHit64> {
     let shape = NetShape {
         nu: patch.degree_u() + 1,
@@ -58,6 +61,7 @@ pub fn intersect_f64(
         shape.rational,
         &cfg,
         false,
+        trim,
         &mut stats,
     )?;
     let (u, v) = h.cell.centre();

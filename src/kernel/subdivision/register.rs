@@ -19,8 +19,10 @@ use super::float::{GBox, GRay};
 use super::heuristics::Corners;
 use super::jump::JumpOutcome;
 use super::param::{ParamCell, Split};
+use super::ray_space::RayFrame;
 use super::search::{NetStack, Node, SearchHit, search};
 use crate::geom::bbox::slab;
+use crate::geom::trim::PatchTrim;
 use crate::kernel::KernelStats;
 
 /// The boxes of a split's two children (lower first), each with the entry `t` of its slab
@@ -221,14 +223,18 @@ impl<N: RegisterNet> NetStack<f32> for RegisterStack<'_, N> {
     }
 }
 
-/// What one search of a register net is asked: the net's root box, the ray, the settings,
-/// and whether any hit will do (shadow rays).
+/// What one search of a register net is asked: the net's root box, the ray (and its
+/// ray-space frame where the ray is searched in ray space, which only the AVX-512 net
+/// supports), the settings, and whether any hit will do (shadow rays).
 #[derive(Clone, Copy, Debug)]
 pub struct Query<'a> {
     pub root: GBox<f32>,
     pub ray: &'a GRay<f32>,
+    pub frame: Option<&'a RayFrame>,
     pub cfg: &'a SubdivisionConfig,
     pub any_hit: bool,
+    /// The patch's trim loops, if it has any ([`super::search::search`]).
+    pub trim: Option<&'a PatchTrim>,
 }
 
 /// The reusable buffers of a register-net search: the pushed nets and the search nodes.
@@ -267,7 +273,7 @@ fn search_portable<N: RegisterNet>(
 ) -> Option<SearchHit<f32>> {
     let mut nets = RegisterStack::new(net, q.ray, slots);
     search(
-        &mut nets, nodes, q.root, q.ray, false, q.cfg, q.any_hit, stats,
+        &mut nets, nodes, q.root, q.ray, false, q.cfg, q.any_hit, q.trim, stats,
     )
 }
 

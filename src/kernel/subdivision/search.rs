@@ -42,6 +42,7 @@ use super::float::{GBox, GRay, KernelFloat};
 use super::heuristics::{Corners, choose};
 use super::jump::JumpOutcome;
 use super::param::{ParamCell, Split};
+use crate::geom::trim::PatchTrim;
 use crate::kernel::KernelStats;
 
 /// Storage of the control nets of the current sub-patch and of the pushed ones.
@@ -106,6 +107,9 @@ pub struct SearchHit<T> {
 
 /// Runs the search from the root net (already in `nets`, with box `root`). `nodes` is
 /// reused scratch (cleared here). With `any_hit` the first final box ends the search.
+/// With `trim`, a final box whose parameter cell's centre the patch's trim loops cut away
+/// is no hit and the search goes on behind it (Dammertz §2.6): the answer is the nearest
+/// surviving hit.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub fn search<T: KernelFloat, S: NetStack<T>>(
@@ -116,6 +120,7 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
     rational: bool,
     cfg: &SubdivisionConfig,
     any_hit: bool,
+    trim: Option<&PatchTrim>,
     stats: &mut KernelStats,
 ) -> Option<SearchHit<T>> {
     stats.patch_tests += 1;
@@ -147,14 +152,21 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
             && (cur.t_enter > ray.tmin || doublings > COARSEN_DOUBLINGS)
             && cur.bbox.l1_diameter() <= coarse;
         if live && (cur.is_final || coarse_final) {
-            best = Some(SearchHit {
-                t: cur.t_enter,
-                cell: cur.cell,
-                bbox: cur.bbox,
+            let kept = trim.is_none_or(|trim| {
+                let (u, v) = cur.cell.centre();
+                stats.trim_tests += 1;
+                trim.keeps(u, v)
             });
-            tmax = cur.t_enter - stop.extent_along_ray(&cur.bbox);
-            if any_hit {
-                return best;
+            if kept {
+                best = Some(SearchHit {
+                    t: cur.t_enter,
+                    cell: cur.cell,
+                    bbox: cur.bbox,
+                });
+                tmax = cur.t_enter - stop.extent_along_ray(&cur.bbox);
+                if any_hit {
+                    return best;
+                }
             }
         } else if live {
             if let Some(full) = stop.full_precision_splits {
@@ -423,7 +435,7 @@ mod tests {
 
     fn run(ray: &Ray, cfg: &SubdivisionConfig) -> (Option<PatchHit>, u64) {
         let mut stats = KernelStats::default();
-        let hit = intersect(&plane_patch(), ray, cfg, &mut stats);
+        let hit = intersect(&plane_patch(), None, ray, cfg, &mut stats);
         (hit, stats.splits)
     }
 
@@ -437,8 +449,9 @@ mod tests {
     fn grazing_ray_splits_stay_within_the_bound_and_hit_within_the_box() {
         // About 1/GRAZING_ANGLE boxes per level along the stretch where the ray runs
         // within a box size of the plane.
-        // In world space (secondary rays): a primary ray's ray-space boxes are tight across
-        // the ray, so there the same ray needs few splits (checked below).
+        // In world space (the search of paths without ray space, such as CPUs without
+        // AVX-512): ray-space boxes are tight across the ray, so there the same ray needs
+        // few splits (checked below).
         let ray = grazing_ray(GRAZING_ANGLE);
         let world = SubdivisionConfig {
             ray_space: false,

@@ -25,6 +25,7 @@ use std::cell::RefCell;
 pub use krawczyk::{Classification, classify};
 pub use stats::TothStats;
 
+use crate::geom::trim::PatchTrim;
 use crate::geom::{BezierPatch, Ray};
 use crate::kernel::{KernelStats, PatchHit};
 use search::{Goal, Scratch};
@@ -81,38 +82,41 @@ thread_local! {
 /// secondary ray leaving this patch (LG90 §6's triviality tests apply).
 pub fn intersect(
     patch: &BezierPatch,
+    trim: Option<&PatchTrim>,
     ray: &Ray,
     cfg: &TothConfig,
     origin: bool,
     stats: &mut KernelStats,
 ) -> Option<PatchHit> {
-    run(patch, ray, cfg, Goal::Nearest, origin, stats)
+    run(patch, ray, cfg, (Goal::Nearest, trim), origin, stats)
 }
 
 /// True when the patch blocks `ray` in `[tmin, tmax]` (shadow rays); `origin` as for
 /// [`intersect`].
 pub fn occluded(
     patch: &BezierPatch,
+    trim: Option<&PatchTrim>,
     ray: &Ray,
     cfg: &TothConfig,
     origin: bool,
     stats: &mut KernelStats,
 ) -> bool {
-    run(patch, ray, cfg, Goal::Any, origin, stats).is_some()
+    run(patch, ray, cfg, (Goal::Any, trim), origin, stats).is_some()
 }
 
 fn run(
     patch: &BezierPatch,
     ray: &Ray,
     cfg: &TothConfig,
-    goal: Goal,
+    (goal, trim): (Goal, Option<&PatchTrim>),
     origin: bool,
     stats: &mut KernelStats,
 ) -> Option<PatchHit> {
     stats.patch_tests += 1;
     let before = stats.toth.box_tests;
-    let hit = SCRATCH
-        .with_borrow_mut(|s| search::search(patch, ray, cfg, goal, s, origin, &mut stats.toth));
+    let hit = SCRATCH.with_borrow_mut(|s| {
+        search::search(patch, ray, cfg, (goal, trim), s, origin, &mut stats.toth)
+    });
     // The kernel's ray–box tests are counted with every other kernel's too.
     stats.box_tests += stats.toth.box_tests - before;
     hit

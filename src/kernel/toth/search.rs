@@ -21,6 +21,7 @@ use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 use crate::geom::interval::{IntervalNet, ParamBox, euclidean_hull};
+use crate::geom::trim::PatchTrim;
 use crate::geom::ulp::ulp_of;
 use crate::geom::{BezierPatch, DAabb, Ray};
 use crate::kernel::PatchHit;
@@ -292,12 +293,13 @@ pub fn examine(
 
 /// Runs the search on one patch. With `Goal::Any` and `cfg.isrt`, a safe region whose ray
 /// parameters lie inside `[tmin, tmax]` answers at once (LG90 §6): the returned hit then
-/// carries the safe region's centre and box rather than a converged point.
+/// carries the safe region's centre and box rather than a converged point. A hit that
+/// `trim` cuts away is no hit and the search goes on (Dammertz §2.6).
 pub fn search(
     patch: &BezierPatch,
     ray: &Ray,
     cfg: &TothConfig,
-    goal: Goal,
+    (goal, trim): (Goal, Option<&PatchTrim>),
     s: &mut Scratch,
     origin: bool,
     stats: &mut TothStats,
@@ -341,7 +343,7 @@ pub fn search(
                 None => final_box(&pr, &mut s.nets, &region, &ray_box, stats),
             },
         };
-        if let Some(h) = hit {
+        if let Some(h) = hit.filter(|h| kept(trim, h)) {
             if goal == Goal::Any {
                 return Some(h);
             }
@@ -350,6 +352,11 @@ pub fn search(
         }
     }
     best
+}
+
+/// Whether a candidate hit survives the patch's trim loops (always, without loops).
+pub fn kept(trim: Option<&PatchTrim>, h: &PatchHit) -> bool {
+    trim.is_none_or(|trim| trim.keeps(h.u as f64, h.v as f64))
 }
 
 /// The ray parameter `τ / w` of the surface point at (u, v).

@@ -1,11 +1,13 @@
 //! Wavefront OBJ free-form geometry (the "free-form curve/surface" part of the OBJ
 //! specification, Appendix B of the Wavefront *Advanced Visualizer* manual): a reader for
 //! Bézier and B-spline surfaces with trimming loops, and a writer for Bézier patches.
-//! Polygonal OBJ files are read as triangle meshes by [`super::mesh`].
+//! Polygonal OBJ files are read as triangle meshes by [`parse_obj_mesh`].
 
+mod polygons;
 mod reader;
 mod writer;
 
+pub use polygons::parse_obj_mesh;
 pub use reader::parse_obj_freeform;
 pub use writer::write_obj_freeform;
 

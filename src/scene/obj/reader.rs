@@ -6,9 +6,10 @@
 //! `curv2`) defined so far; `v/vt/vn` index forms use their `v` part. A backslash at the
 //! end of a line continues the statement on the next line.
 //!
-//! Kept but not applied: the `s0 s1 t0 t1` range of `surf` (the whole surface is kept;
-//! trim loops cut it down). Read and ignored: 3D curves (`curv`), special curves and
-//! points (`scrv`, `sp`), and every polygon, grouping, display and render statement.
+//! The `s0 s1 t0 t1` range of `surf` restricts the surface exactly (knot insertion): a
+//! range reaching past the parameter domain, as rounding in exporters writes it, is taken
+//! within the domain. Read and ignored: 3D curves (`curv`), special curves and points
+//! (`scrv`, `sp`), and every polygon, grouping, display and render statement.
 //!
 //! A piecewise Bézier `surf` (more control points than one patch needs, with `parm`
 //! breakpoints) is split into its patches in span order, u spans fastest; each patch's
@@ -105,6 +106,8 @@ struct Block<'a> {
     parm_u: Option<Parm<'a>>,
     parm_v: Option<Parm<'a>>,
     trims: Vec<TrimLoop>,
+    /// The `surf s0 s1 t0 t1` range.
+    range: ParamRect,
 }
 
 struct Reader<'a, 'p> {
@@ -192,6 +195,7 @@ impl<'a> Reader<'a, '_> {
                 parm_u: None,
                 parm_v: None,
                 trims: Vec::new(),
+                range: ParamRect::UNIT,
             });
             return Ok(());
         }
@@ -217,10 +221,18 @@ impl<'a> Reader<'a, '_> {
             }
             _ => (du, 0),
         };
+        let mut range = ParamRect::UNIT;
         let (what, count) = if kind == ElementKind::Surface {
-            for what in ["s0", "s1", "t0", "t1"] {
-                w.finite(&format!("the parameter range value {what}"))?;
+            let mut r = [0.0; 4];
+            for (x, what) in r.iter_mut().zip(["s0", "s1", "t0", "t1"]) {
+                *x = w.finite(&format!("the parameter range value {what}"))?;
             }
+            range = ParamRect {
+                u0: r[0],
+                u1: r[1],
+                v0: r[2],
+                v1: r[3],
+            };
             ("vertex", self.vertices.len())
         } else {
             ("parameter vertex", self.params.len())
@@ -243,6 +255,7 @@ impl<'a> Reader<'a, '_> {
             parm_u: None,
             parm_v: None,
             trims: Vec::new(),
+            range,
         });
         Ok(())
     }
@@ -475,6 +488,30 @@ impl<'a> Reader<'a, '_> {
         Ok(knots)
     }
 
+    /// The block's `surf` range within `domain`: exporters write ranges a rounding past the
+    /// domain's ends, so the range is clipped to the domain; a range that misses it is an
+    /// error.
+    fn range_within(&self, block: &Block, domain: ParamRect) -> Result<ParamRect, ParseError> {
+        let r = block.range;
+        let clipped = ParamRect {
+            u0: r.u0.max(domain.u0),
+            u1: r.u1.min(domain.u1),
+            v0: r.v0.max(domain.v0),
+            v1: r.v1.min(domain.v1),
+        };
+        if clipped.u0 < clipped.u1 && clipped.v0 < clipped.v1 {
+            Ok(clipped)
+        } else {
+            Err(self.error(
+                &block.keyword,
+                format!(
+                    "expected the range `s0 s1 t0 t1` to overlap the parameter domain [{}, {}] × [{}, {}], found {} {} {} {}",
+                    domain.u0, domain.u1, domain.v0, domain.v1, r.u0, r.u1, r.v0, r.v1
+                ),
+            ))
+        }
+    }
+
     fn surface(&self, block: Block, end: &Token) -> Result<Vec<Surface>, ParseError> {
         let (du, dv) = block.degree;
         let parm_u = self.require_parm(&block.parm_u, "u", &block, end)?;
@@ -508,6 +545,13 @@ impl<'a> Reader<'a, '_> {
                 }
                 let nurbs = NurbsSurface::new(du, dv, knots_u, knots_v, cu, cv, points)
                     .map_err(geometry_error)?;
+                let domain = nurbs.domain();
+                let range = self.range_within(&block, domain)?;
+                let nurbs = if range == domain {
+                    nurbs
+                } else {
+                    nurbs.restricted(range)
+                };
                 Ok(vec![Surface {
                     geometry: SurfaceGeometry::Nurbs(nurbs),
                     trims: block.trims,
@@ -526,6 +570,15 @@ impl<'a> Reader<'a, '_> {
                         "the breakpoints of `parm u` and `parm v`",
                     ));
                 }
+                let range = self.range_within(
+                    &block,
+                    ParamRect {
+                        u0: breaks_u[0],
+                        u1: breaks_u[su],
+                        v0: breaks_v[0],
+                        v1: breaks_v[sv],
+                    },
+                )?;
                 let mut surfaces = Vec::with_capacity(su * sv);
                 for j in 0..sv {
                     for i in 0..su {
@@ -541,6 +594,9 @@ impl<'a> Reader<'a, '_> {
                                 v0: breaks_v[j],
                                 v1: breaks_v[j + 1],
                             });
+                        let Some(patch) = restricted_patch(patch, range) else {
+                            continue;
+                        };
                         surfaces.push(Surface {
                             geometry: SurfaceGeometry::Bezier(patch),
                             trims: block.trims.clone(),
@@ -552,6 +608,46 @@ impl<'a> Reader<'a, '_> {
             }
         }
     }
+}
+
+/// `patch` (with its domain) restricted to `range`: `None` where they do not overlap in an
+/// area, the patch itself where `range` covers it, else the sub-patch over the overlap
+/// (as a NURBS surface on the patch's domain restricted exactly, A5.1).
+fn restricted_patch(patch: BezierPatch, range: ParamRect) -> Option<BezierPatch> {
+    let d = patch.domain();
+    let overlap = ParamRect {
+        u0: d.u0.max(range.u0),
+        u1: d.u1.min(range.u1),
+        v0: d.v0.max(range.v0),
+        v1: d.v1.min(range.v1),
+    };
+    if overlap.u0 >= overlap.u1 || overlap.v0 >= overlap.v1 {
+        return None;
+    }
+    if overlap == d {
+        return Some(patch);
+    }
+    let (du, dv) = (patch.degree_u(), patch.degree_v());
+    let knots = |a: f64, b: f64, p: usize| {
+        let mut k = vec![a; p + 1];
+        k.extend(std::iter::repeat_n(b, p + 1));
+        k
+    };
+    let nurbs = NurbsSurface::new(
+        du,
+        dv,
+        knots(d.u0, d.u1, du),
+        knots(d.v0, d.v1, dv),
+        du + 1,
+        dv + 1,
+        patch.homogeneous_points().to_vec(),
+    )
+    .ok()?;
+    nurbs
+        .restricted(overlap)
+        .to_bezier_patches()
+        .into_iter()
+        .next()
 }
 
 /// The clamped knot vector of a piecewise Bézier curve with the given breakpoints: the

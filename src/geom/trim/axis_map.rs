@@ -1,35 +1,4 @@
-//! Trimming loops in a surface's parameter domain (OBJ `trim` / `hole` with `curv2`,
-//! IGES 144/142, STEP face bounds). They are parsed and kept; the kernels do not evaluate
-//! them yet (Dammertz §2.6).
-
-use glam::DVec3;
-
-/// A planar parameter-space curve (OBJ `curv2`) as a B-spline: homogeneous premultiplied
-/// points `(w u, w v, w)` (w = 1 for non-rational) and a knot vector of
-/// `points.len() + degree + 1` values. A piecewise Bézier curve is stored as the B-spline
-/// with the same breakpoints (end knots repeated `degree + 1` times, interior ones
-/// `degree` times), which is the same curve.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ParamCurve {
-    pub degree: usize,
-    pub knots: Vec<f64>,
-    pub points: Vec<DVec3>,
-}
-
-/// A piece of a loop: a parameter curve restricted to `[t0, t1]`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct TrimSegment {
-    pub t0: f64,
-    pub t1: f64,
-    pub curve: ParamCurve,
-}
-
-/// A closed loop: the outer boundary (`trim`) or a hole (`hole`).
-#[derive(Clone, Debug, PartialEq)]
-pub struct TrimLoop {
-    pub hole: bool,
-    pub segments: Vec<TrimSegment>,
-}
+//! The map from a NURBS parameter to the parameter trims are written in.
 
 /// How one parameter of a surface's NURBS form maps to the parameter its trim loops are
 /// written in. CAD formats give trims of analytic surfaces (IGES 120, 190–198; STEP
@@ -67,11 +36,40 @@ impl AxisMap {
             }
         }
     }
+
+    /// The NURBS parameter at trim parameter `a`, the inverse of [`Self::apply`]: on the
+    /// arc whose angles bracket `a` (the nearest end arc outside them),
+    /// s = (tan(α/2) / tan(Δ/4) + 1) / 2. The tessellator needs it to place the samples of
+    /// a trim loop on the surface.
+    pub fn invert(&self, a: f64) -> f64 {
+        match self {
+            AxisMap::Identity => a,
+            AxisMap::Arcs { breaks, angles } => {
+                let n = angles.len() - 1;
+                // Angles run one way along the breaks; count the inner ones a has passed.
+                let rising = angles[n] >= angles[0];
+                let i = angles[1..n]
+                    .iter()
+                    .take_while(|&&x| if rising { x <= a } else { x >= a })
+                    .count();
+                let (b0, b1) = (breaks[i], breaks[i + 1]);
+                let (a0, a1) = (angles[i], angles[i + 1]);
+                let quarter = (0.25 * (a1 - a0)).tan();
+                let s = if quarter == 0.0 {
+                    0.5
+                } else {
+                    0.5 * ((0.5 * (a - 0.5 * (a0 + a1))).tan() / quarter + 1.0)
+                };
+                b0 + (b1 - b0) * s
+            }
+        }
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::DVec3;
 
     #[test]
     fn arc_map_inverts_the_rational_quadratic_arc() {
@@ -93,6 +91,7 @@ mod tests {
             let h = p0 * (1.0 - s) * (1.0 - s) + p1 * 2.0 * s * (1.0 - s) + p2 * s * s;
             let angle = (h.y / h.z).atan2(h.x / h.z);
             assert!((map.apply(2.0 + s) - angle).abs() < 1e-14, "s = {s}");
+            assert!((map.invert(angle) - (2.0 + s)).abs() < 1e-14, "s = {s}");
         }
     }
 }

@@ -1,0 +1,288 @@
+//! Curve entities as exact NURBS (OpenCASCADE's `IGESToBRep_BasicCurve`): 100 circular
+//! arc, 102 composite, 104 conic arc, 106 copious data, 110 line, 112 parametric spline,
+//! 126 rational B-spline. Each becomes one or more pieces, each a NURBS curve with the
+//! parameter range it is used on, in model space (the entity's transform applied).
+
+use glam::{DVec2, DVec3, DVec4};
+use std::f64::consts::TAU;
+
+use super::Model;
+use super::entities::Entity;
+use crate::geom::nurbs::NurbsCurve;
+use crate::geom::nurbs::analytic::{self, Frame};
+use crate::geom::trim::AxisMap;
+
+/// One piece of a curve: a NURBS curve used on `[t0, t1]`, and the map from its NURBS
+/// parameter to the entity's own (the angle, for arcs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Piece {
+    pub curve: NurbsCurve,
+    pub t0: f64,
+    pub t1: f64,
+    pub map: AxisMap,
+}
+
+impl Piece {
+    fn whole(curve: NurbsCurve) -> Piece {
+        Piece::mapped((curve, AxisMap::Identity))
+    }
+
+    fn mapped((curve, map): (NurbsCurve, AxisMap)) -> Piece {
+        let (t0, t1) = crate::geom::nurbs::knots::domain(curve.degree, &curve.knots);
+        Piece { curve, t0, t1, map }
+    }
+}
+
+/// Nesting limit for composites of composites, against cycles.
+const MAX_DEPTH: usize = 16;
+
+/// The pieces of the curve entity at directory pointer `pointer`, in model space.
+pub fn pieces(model: &Model, pointer: usize) -> Result<Vec<Piece>, String> {
+    pieces_at(model, pointer, 0)
+}
+
+fn pieces_at(model: &Model, pointer: usize, depth: usize) -> Result<Vec<Piece>, String> {
+    if depth > MAX_DEPTH {
+        return Err(format!(
+            "curves nest deeper than {MAX_DEPTH} (a cycle?) at D {pointer}"
+        ));
+    }
+    let (entry, entity) = model.get(pointer)?;
+    let mut out = match entity {
+        Entity::Composite(parts) => {
+            let mut all = Vec::new();
+            for &p in parts {
+                all.extend(pieces_at(model, p, depth + 1)?);
+            }
+            // The composite's own transform applies on top of its parts'.
+            for piece in &mut all {
+                transform(&mut piece.curve, &model.transform(entry.transform)?);
+            }
+            return Ok(all);
+        }
+        Entity::Arc {
+            z,
+            centre,
+            start,
+            end,
+        } => vec![arc(*z, *centre, *start, *end)?],
+        Entity::Conic {
+            coefficients,
+            z,
+            start,
+            end,
+        } => vec![conic(coefficients, *z, *start, *end)?],
+        Entity::Copious(points) => vec![polyline(points)?],
+        Entity::Line { start, end } => vec![Piece::whole(
+            analytic::line_segment(*start, *end, 0.0, 1.0).map_err(|e| e.to_string())?,
+        )],
+        Entity::Spline {
+            breaks,
+            coefficients,
+        } => vec![spline(breaks, coefficients)?],
+        Entity::BSplineCurve(c) => {
+            let curve = NurbsCurve {
+                degree: c.degree,
+                knots: c.knots.clone(),
+                points: c
+                    .points
+                    .iter()
+                    .zip(&c.weights)
+                    .map(|(p, &w)| (*p * w).extend(w))
+                    .collect(),
+            };
+            if c.degree == 0 {
+                return Err("degree 0 is outside 1..=15".into());
+            }
+            crate::geom::nurbs::knots::validate(c.degree, &curve.knots, curve.points.len())
+                .map_err(|e| e.to_string())?;
+            if c.weights
+                .iter()
+                .any(|w| w.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
+            {
+                return Err("a weight is not positive".into());
+            }
+            let (d0, d1) = crate::geom::nurbs::knots::domain(c.degree, &curve.knots);
+            let (t0, t1) = (c.range[0].max(d0), c.range[1].min(d1));
+            if t0.partial_cmp(&t1) != Some(std::cmp::Ordering::Less) {
+                return Err(format!(
+                    "the parameter range [{}, {}] is empty",
+                    c.range[0], c.range[1]
+                ));
+            }
+            vec![Piece {
+                curve,
+                t0,
+                t1,
+                map: AxisMap::Identity,
+            }]
+        }
+        other => {
+            return Err(format!(
+                "entity {} (D {pointer}) is not a curve{}",
+                entry.entity_type,
+                if matches!(other, Entity::Unsupported) {
+                    " type that is read"
+                } else {
+                    ""
+                }
+            ));
+        }
+    };
+    let m = model.transform(entry.transform)?;
+    for piece in &mut out {
+        transform(&mut piece.curve, &m);
+    }
+    Ok(out)
+}
+
+fn transform(c: &mut NurbsCurve, m: &glam::DAffine3) {
+    for p in &mut c.points {
+        let e = m.transform_point3(p.truncate() / p.w);
+        *p = (e * p.w).extend(p.w);
+    }
+}
+
+/// The definition space's axes about `origin`.
+fn plane_frame(origin: DVec3) -> Frame {
+    Frame {
+        origin,
+        x: DVec3::X,
+        y: DVec3::Y,
+        z: DVec3::Z,
+    }
+}
+
+/// 100 (§4.3): counter-clockwise from start to end about the centre; equal start and end
+/// make a full circle. The parameter is the angle (the knots are angles at the pieces'
+/// ends; the arc's own parameterisation in §4.3 is by angle too).
+fn arc(z: f64, centre: DVec2, start: DVec2, end: DVec2) -> Result<Piece, String> {
+    let radius = (start - centre).length();
+    let a0 = (start - centre).to_angle();
+    let mut a1 = (end - centre).to_angle();
+    while a1 <= a0 {
+        a1 += TAU;
+    }
+    Ok(Piece::mapped(
+        analytic::circle_arc(&plane_frame(centre.extend(z)), radius, a0, a1)
+            .map_err(|e| e.to_string())?,
+    ))
+}
+
+/// 104 (§4.5): an ellipse in general position (B² < 4AC) is brought to its centre and axes
+/// and converted exactly; a parabola must be in a standard position (A x² + E y = 0 or
+/// C y² + D x = 0). Hyperbolas are refused by name (not yet converted).
+fn conic(k: &[f64; 6], z: f64, start: DVec2, end: DVec2) -> Result<Piece, String> {
+    let [a, b, c, d, e, f] = *k;
+    let disc = b * b - 4.0 * a * c;
+    let err = |x: analytic::ShapeError| x.to_string();
+    if disc < 0.0 {
+        // Centre: the gradient vanishes. Axes: rotate by θ with tan 2θ = B / (A − C).
+        let det = 4.0 * a * c - b * b;
+        let centre = DVec2::new((b * e - 2.0 * c * d) / det, (b * d - 2.0 * a * e) / det);
+        let f0 = a * centre.x * centre.x
+            + b * centre.x * centre.y
+            + c * centre.y * centre.y
+            + d * centre.x
+            + e * centre.y
+            + f;
+        let theta = 0.5 * b.atan2(a - c);
+        let (s, co) = theta.sin_cos();
+        let a2 = a * co * co + b * co * s + c * s * s;
+        let c2 = a * s * s - b * co * s + c * co * co;
+        let (ra, rb) = ((-f0 / a2).sqrt(), (-f0 / c2).sqrt());
+        let x = DVec3::new(co, s, 0.0);
+        let frame = Frame {
+            origin: centre.extend(z),
+            x,
+            y: DVec3::Z.cross(x),
+            z: DVec3::Z,
+        };
+        let local = |p: DVec2| {
+            let q = p - centre;
+            let (u, v) = (q.dot(DVec2::new(co, s)), q.dot(DVec2::new(-s, co)));
+            (v / rb).atan2(u / ra)
+        };
+        let t0 = local(start);
+        let mut t1 = local(end);
+        while t1 <= t0 {
+            t1 += TAU;
+        }
+        return Ok(Piece::mapped(
+            analytic::ellipse_arc(&frame, ra, rb, [t0, t1]).map_err(err)?,
+        ));
+    }
+    let frame = plane_frame(DVec3::new(0.0, 0.0, z));
+    if disc == 0.0 && b == 0.0 && f == 0.0 {
+        if c == 0.0 && d == 0.0 && a != 0.0 && e != 0.0 {
+            // y = −(A/E) x²: the parabola of `analytic` with its axes swapped.
+            let fr = Frame {
+                origin: frame.origin,
+                x: DVec3::Y,
+                y: DVec3::X,
+                z: -DVec3::Z,
+            };
+            let (t0, t1) = (start.x.min(end.x), start.x.max(end.x));
+            return Ok(Piece::whole(
+                analytic::parabola_arc(&fr, -a / e, t0, t1).map_err(err)?,
+            ));
+        }
+        if a == 0.0 && e == 0.0 && c != 0.0 && d != 0.0 {
+            let (t0, t1) = (start.y.min(end.y), start.y.max(end.y));
+            return Ok(Piece::whole(
+                analytic::parabola_arc(&frame, -c / d, t0, t1).map_err(err)?,
+            ));
+        }
+    }
+    Err("conic arcs other than ellipses and parabolas in standard position (§4.5) are not supported yet".into())
+}
+
+/// 106: the points joined in order, parameter i at point i.
+fn polyline(points: &[DVec3]) -> Result<Piece, String> {
+    if points.len() < 2 {
+        return Err("a copious data curve needs at least two points".into());
+    }
+    let n = points.len();
+    let mut knots = vec![0.0];
+    knots.extend((0..n).map(|i| i as f64));
+    knots.push((n - 1) as f64);
+    Ok(Piece::whole(NurbsCurve {
+        degree: 1,
+        knots,
+        points: points.iter().map(|p| p.extend(1.0)).collect(),
+    }))
+}
+
+/// 112 (§4.14): each cubic segment `a + b s + c s² + d s³`, s in [0, h], becomes its
+/// Bézier form on [0, 1] (coefficients scaled by powers of h, then the power-to-Bernstein
+/// conversion), joined with triple knots at the breaks: the same curve exactly.
+fn spline(breaks: &[f64], coefficients: &[[[f64; 4]; 3]]) -> Result<Piece, String> {
+    if coefficients.is_empty()
+        || breaks
+            .windows(2)
+            .any(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater))
+    {
+        return Err("the breakpoints of a parametric spline must increase".into());
+    }
+    let mut knots = vec![breaks[0]; 4];
+    let mut points = Vec::new();
+    for (k, seg) in coefficients.iter().enumerate() {
+        let h = breaks[k + 1] - breaks[k];
+        let bez = |[a, b, c, d]: [f64; 4]| {
+            let (b, c, d) = (b * h, c * h * h, d * h * h * h);
+            [a, a + b / 3.0, a + 2.0 * b / 3.0 + c / 3.0, a + b + c + d]
+        };
+        let (x, y, z) = (bez(seg[0]), bez(seg[1]), bez(seg[2]));
+        let first = if k == 0 { 0 } else { 1 };
+        for i in first..4 {
+            points.push(DVec4::new(x[i], y[i], z[i], 1.0));
+        }
+        let times = if k + 1 == coefficients.len() { 4 } else { 3 };
+        knots.extend(std::iter::repeat_n(breaks[k + 1], times));
+    }
+    Ok(Piece::whole(NurbsCurve {
+        degree: 3,
+        knots,
+        points,
+    }))
+}

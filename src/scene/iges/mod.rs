@@ -1,0 +1,336 @@
+//! IGES 5.3 (`.igs`, `.iges`), the exchange format CAD systems write, read exactly: no
+//! tessellation; analytic geometry becomes rational NURBS through
+//! `geom::nurbs::analytic`. Layered as OpenCASCADE's IGES reader: `records` (the file's
+//! syntax, `IGESData`), `directory` (Directory Entries), `entities` (typed entities,
+//! `IGESGeom`), then translation by kind (`IGESToBRep`): `curves`, `surfaces`, `trimmed`
+//! (144 over any surface, 142 curves on surfaces).
+//!
+//! Drawn are the visible entities that are not physically part of others (§2.3.1 status):
+//! trimmed surfaces (144) and bare surfaces (128, 108, 118, 120, 122). What is not read
+//! is counted by type in [`Report`]; a surface that cannot be converted is named by its
+//! directory sequence number; neither is dropped silently.
+
+pub mod curves;
+pub mod directory;
+pub mod entities;
+pub mod records;
+pub mod surfaces;
+pub mod trimmed;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use glam::{DAffine3, DVec3};
+
+use self::directory::DirEntry;
+use self::entities::{Entity, Params};
+use self::records::Value;
+use crate::scene::error::ParseError;
+use crate::scene::model::Surface;
+
+/// The file's entities, addressed by directory pointer.
+pub struct Model {
+    pub entries: Vec<DirEntry>,
+    pub entities: Vec<Entity>,
+}
+
+/// Nesting limit of transforms referring to transforms, against cycles.
+const MAX_TRANSFORM_CHAIN: usize = 32;
+
+impl Model {
+    /// The entry and entity a directory pointer (odd sequence number) names.
+    pub fn get(&self, pointer: usize) -> Result<(&DirEntry, &Entity), String> {
+        let i = pointer.wrapping_sub(1) / 2;
+        if pointer.is_multiple_of(2) || i >= self.entries.len() {
+            return Err(format!("D {pointer} is not a directory entry of this file"));
+        }
+        Ok((&self.entries[i], &self.entities[i]))
+    }
+
+    /// The transform a directory entry's transform pointer names, chained through the
+    /// transforms' own pointers (§4.21: the 124's matrix is itself in the space of the
+    /// one it points to); identity for 0.
+    pub fn transform(&self, mut pointer: usize) -> Result<DAffine3, String> {
+        let mut m = DAffine3::IDENTITY;
+        for _ in 0..MAX_TRANSFORM_CHAIN {
+            if pointer == 0 {
+                return Ok(m);
+            }
+            let (entry, entity) = self.get(pointer)?;
+            let Entity::Transform(t) = entity else {
+                return Err(format!(
+                    "the transform pointer D {pointer} names entity {}, not 124",
+                    entry.entity_type
+                ));
+            };
+            m = *t * m;
+            pointer = entry.transform;
+        }
+        Err(format!(
+            "transforms chain deeper than {MAX_TRANSFORM_CHAIN} (a cycle?)"
+        ))
+    }
+
+    /// The colour of an entry (RGB in [0, 1]): a 314 it points to, or one of the eight
+    /// predefined colours (§2.3.1 field 13).
+    pub fn colour(&self, entry: &DirEntry) -> Option<DVec3> {
+        match entry.colour {
+            c if c < 0 => match self.get(c.unsigned_abs() as usize).ok()?.1 {
+                Entity::Colour(rgb) => Some((*rgb / 100.0).clamp(DVec3::ZERO, DVec3::ONE)),
+                _ => None,
+            },
+            1 => Some(DVec3::ZERO),
+            2 => Some(DVec3::X),
+            3 => Some(DVec3::Y),
+            4 => Some(DVec3::Z),
+            5 => Some(DVec3::new(1.0, 1.0, 0.0)),
+            6 => Some(DVec3::new(1.0, 0.0, 1.0)),
+            7 => Some(DVec3::new(0.0, 1.0, 1.0)),
+            8 => Some(DVec3::ONE),
+            _ => None,
+        }
+    }
+}
+
+/// What reading found besides the surfaces: units, and what was not drawn.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Report {
+    /// Global parameter 15 (or the name of the unit flag, parameter 14).
+    pub units: String,
+    /// Global parameter 13, model space scale.
+    pub scale: f64,
+    /// Drawn entities of types that are not read, by type.
+    pub ignored: BTreeMap<i32, usize>,
+    /// Surfaces that could not be converted, with their directory sequence number.
+    pub failed: Vec<String>,
+    /// Trim curves projected from model space, and the largest distance of a projected
+    /// point from the surface.
+    pub projected: usize,
+    pub max_projection_error: f64,
+}
+
+impl Report {
+    /// The lines `info` prints.
+    pub fn lines(&self) -> Vec<String> {
+        let mut out = vec![format!(
+            "IGES units: {} (model scale {})",
+            self.units, self.scale
+        )];
+        if self.projected > 0 {
+            out.push(format!(
+                "IGES trim curves projected from model space: {} (largest projection error {:e})",
+                self.projected, self.max_projection_error
+            ));
+        }
+        if let Some(w) = self.ignored_line() {
+            out.push(w);
+        }
+        out.extend(
+            self.failed
+                .iter()
+                .map(|f| format!("IGES surface not converted: {f}")),
+        );
+        out
+    }
+
+    /// One line naming every ignored entity type and its count, or `None`.
+    pub fn ignored_line(&self) -> Option<String> {
+        if self.ignored.is_empty() {
+            return None;
+        }
+        let parts: Vec<String> = self
+            .ignored
+            .iter()
+            .map(|(t, n)| format!("{n} × entity {t} ({})", entity_name(*t)))
+            .collect();
+        Some(format!("ignored: {}", parts.join(", ")))
+    }
+}
+
+/// Names of entity types (IGES 5.3 chapter 4) for the report.
+fn entity_name(t: i32) -> &'static str {
+    match t {
+        100 => "circular arc, not drawn",
+        102 => "composite curve, not drawn",
+        104 => "conic arc, not drawn",
+        106 => "copious data, not drawn",
+        110 => "line, not drawn",
+        112 => "parametric spline curve, not drawn",
+        126 => "rational B-spline curve, not drawn",
+        142 => "curve on a surface, not drawn",
+        114 => "parametric spline surface",
+        116 => "point",
+        123 => "direction",
+        125 => "flash",
+        130 => "offset curve",
+        140 => "offset surface",
+        141 => "boundary",
+        143 => "bounded surface",
+        186 => "manifold solid B-rep",
+        190 => "plane surface",
+        192 => "right circular cylindrical surface",
+        194 => "right circular conical surface",
+        196 => "spherical surface",
+        198 => "toroidal surface",
+        212 | 213 => "text",
+        308 => "subfigure definition",
+        402 => "associativity",
+        406 => "property",
+        408 => "singular subfigure instance",
+        502 => "vertex list",
+        504 => "edge list",
+        508 => "loop",
+        510 => "face",
+        514 => "shell",
+        _ => "not supported",
+    }
+}
+
+/// A converted surface and the colour of its entity.
+pub struct Drawn {
+    pub surface: Surface,
+    pub colour: Option<DVec3>,
+}
+
+/// The drawn surfaces of a file, and the report.
+pub struct Iges {
+    pub surfaces: Vec<Drawn>,
+    pub report: Report,
+}
+
+/// Unit flag names (Global parameter 14, §2.2.4.3.14).
+fn unit_name(flag: i64) -> &'static str {
+    match flag {
+        1 => "INCH",
+        2 => "MM",
+        4 => "FT",
+        5 => "MI",
+        6 => "M",
+        7 => "KM",
+        8 => "MIL",
+        9 => "UM",
+        10 => "CM",
+        11 => "UIN",
+        _ => "unknown",
+    }
+}
+
+/// Parses an IGES file. Syntax errors are located parse errors; surfaces that cannot be
+/// converted are reported, not fatal.
+pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
+    let sections = records::sections(path, src)?;
+    let (delims, global) = records::global(path, &sections.global)?;
+    let text = |i: usize| match global.get(i - 1).map(|t| &t.value) {
+        Some(Value::Text(s)) => Some(s.clone()),
+        _ => None,
+    };
+    let number = |i: usize| match global.get(i - 1).map(|t| &t.value) {
+        Some(Value::Number { value, .. }) => Some(*value),
+        _ => None,
+    };
+    let flag = number(14).unwrap_or(1.0) as i64;
+    let units = match (flag, text(15)) {
+        (3, Some(name)) => name,
+        (f, _) => unit_name(f).to_string(),
+    };
+    let mut report = Report {
+        units,
+        scale: number(13).unwrap_or(1.0),
+        ..Default::default()
+    };
+    let entries = directory::entries(path, &sections.directory)?;
+    let mut entities = Vec::with_capacity(entries.len());
+    for entry in &entries {
+        if !entities::is_supported(entry.entity_type) {
+            entities.push(Entity::Unsupported);
+            continue;
+        }
+        let first = entry.param_start.wrapping_sub(1);
+        let records = sections
+            .parameters
+            .get(first..first.saturating_add(entry.param_count.max(1)))
+            .ok_or_else(|| {
+                ParseError::new(
+                    path,
+                    entry.line,
+                    9,
+                    format!(
+                        "entity {} (D {}): expected its parameter data at P {} ({} records), past the Parameter Data section's {} records",
+                        entry.entity_type,
+                        entry.sequence,
+                        entry.param_start,
+                        entry.param_count,
+                        sections.parameters.len()
+                    ),
+                )
+            })?;
+        let tokens = records::parameters(path, records, delims)?;
+        let p = Params {
+            path,
+            entry,
+            tokens,
+        };
+        if !matches!(p.tokens.first().map(|t| &t.value), Some(Value::Number { value, .. }) if *value == f64::from(entry.entity_type))
+        {
+            let t = &p.tokens[0];
+            return Err(ParseError::new(
+                path,
+                t.line,
+                t.column,
+                format!(
+                    "entity {} (D {}): expected its parameter data to start with its type {}, found `{}`",
+                    entry.entity_type, entry.sequence, entry.entity_type, t.written
+                ),
+            ));
+        }
+        entities.push(entities::read(&p)?);
+    }
+    let model = Model { entries, entities };
+    // Some writers leave the surface under a 144 marked independent; it is drawn through
+    // the 144 only (drawn again, its untrimmed whole would cover the trims).
+    let trimmed: std::collections::HashSet<usize> = model
+        .entities
+        .iter()
+        .filter_map(|e| match e {
+            Entity::Trimmed { surface, .. } => Some(*surface),
+            _ => None,
+        })
+        .collect();
+    let mut surfaces = Vec::new();
+    for (entry, entity) in model.entries.iter().zip(&model.entities) {
+        if !entry.is_drawn() || trimmed.contains(&entry.sequence) {
+            continue;
+        }
+        let converted = match entity {
+            Entity::Trimmed { .. } => trimmed::trimmed(&model, entry.sequence, &mut report),
+            Entity::BSplineSurface(_)
+            | Entity::Plane { .. }
+            | Entity::Ruled { .. }
+            | Entity::Revolution { .. }
+            | Entity::Tabulated { .. } => trimmed::untrimmed(&model, entry.sequence),
+            Entity::Transform(_) | Entity::Colour(_) => continue,
+            _ => {
+                *report.ignored.entry(entry.entity_type).or_default() += 1;
+                continue;
+            }
+        };
+        match converted {
+            Ok(surface) => surfaces.push(Drawn {
+                surface,
+                colour: model.colour(entry),
+            }),
+            Err(why) => report.failed.push(format!(
+                "entity {} (D {}): {why}",
+                entry.entity_type, entry.sequence
+            )),
+        }
+    }
+    Ok(Iges { surfaces, report })
+}
+
+/// Reads an IGES file from disk.
+pub fn read_iges(path: &Path) -> Result<Iges, crate::scene::LoadError> {
+    // Hollerith strings may hold any 8-bit text; the geometry is ASCII.
+    let bytes = std::fs::read(path).map_err(|e| crate::scene::LoadError::io(path, e))?;
+    Ok(parse_iges(path, &String::from_utf8_lossy(&bytes))?)
+}

@@ -1,0 +1,162 @@
+//! Surface entities as exact rational NURBS (OpenCASCADE's `IGESToBRep_BasicSurface`),
+//! each in the parameterisation the standard gives, so that parameter-space trim curves
+//! land right: 128 rational B-spline surface, 118 ruled surface, 120 surface of revolution,
+//! 122 tabulated cylinder. Planes (108) have no parameterisation and are built around
+//! their boundaries in `trimmed`.
+
+use glam::DVec4;
+
+use super::Model;
+use super::curves::{self, Piece};
+use super::entities::Entity;
+use crate::geom::nurbs::analytic;
+use crate::geom::nurbs::{NurbsCurve, NurbsSurface};
+use crate::geom::trim::AxisMap;
+
+/// A surface in model space, the maps of its parameters to the trim parameters, and the
+/// 128's parameter range where it is narrower than the knot domain.
+pub struct Converted {
+    pub surface: NurbsSurface,
+    pub maps: [AxisMap; 2],
+    pub range: Option<[f64; 4]>,
+    /// Per direction `(scale, offset)`: the trim parameter is `offset + scale · p` for the
+    /// entity's parameter p (the 122's normalised u is the directrix parameter scaled).
+    pub to_trim: [(f64, f64); 2],
+}
+
+const SAME: [(f64, f64); 2] = [(1.0, 0.0), (1.0, 0.0)];
+
+fn err(e: impl std::fmt::Display) -> String {
+    e.to_string()
+}
+
+/// The surface entity at `pointer`, in model space (its transform applied).
+pub fn surface(model: &Model, pointer: usize) -> Result<Converted, String> {
+    let (entry, entity) = model.get(pointer)?;
+    let mut c = match entity {
+        Entity::BSplineSurface(b) => {
+            let points = b
+                .points
+                .iter()
+                .zip(&b.weights)
+                .map(|(p, &w)| (*p * w).extend(w))
+                .collect();
+            let s = NurbsSurface::new(
+                b.degree[0],
+                b.degree[1],
+                b.knots[0].clone(),
+                b.knots[1].clone(),
+                b.counts[0],
+                b.counts[1],
+                points,
+            )
+            .map_err(err)?;
+            let d = s.domain();
+            let [u0, u1, v0, v1] = b.range;
+            let narrower = u0 > d.u0 || u1 < d.u1 || v0 > d.v0 || v1 < d.v1;
+            Converted {
+                surface: s,
+                maps: Default::default(),
+                range: (narrower && u0 < u1 && v0 < v1).then_some(b.range),
+                to_trim: SAME,
+            }
+        }
+        Entity::Ruled {
+            curves: [a, b],
+            reversed,
+            ..
+        } => {
+            // §4.16: S(u, v) = (1 − v) C1(u) + v C2(u) on [0, 1]², both curves by their
+            // normalised parameter (form 1; form 0, equal arc length, is the same for the
+            // lines and arcs CAD systems write it with). DIRFLG 1 reverses C2.
+            let c1 = single(curves::pieces(model, *a)?)?;
+            let mut c2 = single(curves::pieces(model, *b)?)?;
+            if *reversed {
+                c2 = reverse(&c2);
+            }
+            if c1.map != AxisMap::Identity || c2.map != AxisMap::Identity {
+                return Err("a ruled surface between arcs or ellipses is not supported yet (its normalised parameter has no exact map to the arc angle once the rails' breaks are merged)".into());
+            }
+            let (s, maps) = analytic::ruled(&c1.curve, &c2.curve).map_err(err)?;
+            Converted {
+                surface: s,
+                maps,
+                range: None,
+                to_trim: SAME,
+            }
+        }
+        Entity::Revolution {
+            axis,
+            generatrix,
+            angles,
+        } => {
+            // §4.18: S(t, θ), t the generatrix's parameter, θ from the start to the end
+            // angle: the transpose of `analytic::revolution`, which puts the angle first.
+            let Entity::Line { start, end } = model.get(*axis)?.1 else {
+                return Err(format!("the axis D {axis} is not a line (110)"));
+            };
+            let m = model.transform(model.get(*axis)?.0.transform)?;
+            let (p0, p1) = (m.transform_point3(*start), m.transform_point3(*end));
+            let g = single(curves::pieces(model, *generatrix)?)?;
+            let (s, [angle, _]) =
+                analytic::revolution(&g.curve, p0, p1 - p0, angles[0], angles[1]).map_err(err)?;
+            Converted {
+                surface: s.transposed(),
+                maps: [g.map, angle],
+                range: None,
+                to_trim: SAME,
+            }
+        }
+        Entity::Tabulated { directrix, end } => {
+            // §4.19: S(u, v) = C(t) + v (L − C(t0)), t = t0 + u (t1 − t0), u, v in [0, 1].
+            // The NURBS u is the directrix's own parameter, so trims map to t.
+            let c = single(curves::pieces(model, *directrix)?)?;
+            let start = c.curve.eval(c.t0);
+            let (s, [_, along]) =
+                analytic::extrusion(&c.curve, *end - start, 0.0, 1.0).map_err(err)?;
+            Converted {
+                surface: s,
+                maps: [c.map, along],
+                range: None,
+                to_trim: [(c.t1 - c.t0, c.t0), (1.0, 0.0)],
+            }
+        }
+        _ => {
+            return Err(format!(
+                "the surface D {pointer} is entity {}, which is not a surface that is read",
+                entry.entity_type
+            ));
+        }
+    };
+    c.surface.transform(&model.transform(entry.transform)?);
+    Ok(c)
+}
+
+/// The one piece of a curve that must be a single NURBS curve (a generatrix, directrix or
+/// rail).
+fn single(mut pieces: Vec<Piece>) -> Result<Piece, String> {
+    if pieces.len() != 1 {
+        return Err(format!(
+            "a composite curve of {} pieces as generatrix, directrix or rail is not supported yet",
+            pieces.len()
+        ));
+    }
+    Ok(pieces.remove(0))
+}
+
+/// The same curve run backwards: knots reflected, points reversed.
+fn reverse(p: &Piece) -> Piece {
+    let (a, b) = (p.curve.knots[0], p.curve.knots[p.curve.knots.len() - 1]);
+    let mut points: Vec<DVec4> = p.curve.points.clone();
+    points.reverse();
+    Piece {
+        curve: NurbsCurve {
+            degree: p.curve.degree,
+            knots: p.curve.knots.iter().rev().map(|k| a + b - k).collect(),
+            points,
+        },
+        t0: a + b - p.t1,
+        t1: a + b - p.t0,
+        map: p.map.clone(),
+    }
+}

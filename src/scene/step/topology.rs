@@ -1,0 +1,495 @@
+//! B-rep faces to trimmed NURBS surfaces: every ADVANCED_FACE's bounds become trim loops
+//! in its surface's parameters (ISO 10303-42 §5.4: face_bound, edge_loop, oriented_edge,
+//! edge_curve), and the surface becomes an exact NURBS over the loops' extent
+//! (OpenCASCADE's StepToTopoDS_TranslateFace).
+//!
+//! An edge's piece of a loop is its PCURVE on the face's surface where the file gives one
+//! that agrees with the 3D curve, exact (lines, B-splines, circle and ellipse arcs);
+//! otherwise the 3D edge curve is projected, sample by sample, into the surface's
+//! parameters (closed forms for the elementary surfaces, point inversion for B-splines),
+//! refined until the chord between samples lies within [`CHORD_TOLERANCE`] of the projection,
+//! and the largest distance found is reported as the projection error.
+//!
+//! Periodic parameters (the angles of cylinders, cones, spheres, tori, revolutions) are
+//! unwrapped across the seam so that each loop is continuous: a piece is shifted by whole
+//! periods to start where the previous one ended, and the two sides of a seam edge (its two
+//! pcurves) are taken once each. A loop that goes once around a periodic direction (the
+//! circle bounding a cylinder face) is closed through a line beyond the surface's other
+//! parameter range, so that even–odd parity over all loops (how the kernels apply trims)
+//! still sees the band between two such loops as inside.
+
+use std::collections::HashMap;
+
+use glam::{DVec2, DVec3, DVec4};
+
+use super::entities::{Curve, Edge, Face, PCurve, SurfaceDef};
+use super::geometry::{curve_to_nurbs, surface_to_nurbs};
+use crate::geom::nurbs::NurbsCurve;
+use crate::geom::nurbs::inversion::Inverter;
+use crate::geom::trim::{ParamCurve, TrimLoop, TrimSegment};
+use crate::scene::model::{Surface, SurfaceGeometry};
+
+/// Largest distance, relative to the model's size, between a projected edge and the
+/// surface image of the polyline that stands for it in the domain: 1e-5 of the model is
+/// well below a pixel of any framing view (a 4k image resolves 2.5e-4 of it).
+pub const CHORD_TOLERANCE: f64 = 1e-5;
+/// How far a pcurve may stray from its 3D curve, relative to the model's size, and still
+/// be used: CAD systems write edges to tolerances of about 1e-7 to 1e-4 of the part.
+const PCURVE_TOLERANCE: f64 = 1e-4;
+/// Segments a projected edge starts with before refinement (enough that a curve bending
+/// back on itself cannot hide between the first samples).
+const MIN_SEGMENTS: usize = 4;
+/// Halvings of a projected segment at most: 4 · 2^10 = 4096 samples per edge.
+const MAX_REFINE: usize = 10;
+
+/// A converted face and what its conversion measured.
+pub struct FaceOutcome {
+    pub surface: Surface,
+    /// Largest distance between a projected edge and its image in the domain.
+    pub projection_error: f64,
+    /// Edges whose pieces came from projection rather than a pcurve.
+    pub projected_edges: usize,
+}
+
+/// A piece of a loop: a curve segment in the parameter plane, traversed backwards when
+/// `reversed`.
+#[derive(Clone, Debug)]
+struct Piece {
+    seg: TrimSegment,
+    reversed: bool,
+    /// Where the traversal starts and ends, evaluated once.
+    ends: [DVec2; 2],
+}
+
+/// The parameter-plane curve as a NURBS curve in the z = 0 plane, to evaluate it.
+fn as_nurbs(c: &ParamCurve) -> NurbsCurve {
+    NurbsCurve {
+        degree: c.degree,
+        knots: c.knots.clone(),
+        points: c
+            .points
+            .iter()
+            .map(|p| DVec4::new(p.x, p.y, 0.0, p.z))
+            .collect(),
+    }
+}
+
+/// A NURBS curve lying in z = 0 (a pcurve) as a parameter-plane curve.
+fn as_param(c: &NurbsCurve) -> ParamCurve {
+    ParamCurve {
+        degree: c.degree,
+        knots: c.knots.clone(),
+        points: c.points.iter().map(|p| DVec3::new(p.x, p.y, p.w)).collect(),
+    }
+}
+
+impl Piece {
+    fn new(seg: TrimSegment, reversed: bool) -> Piece {
+        let c = as_nurbs(&seg.curve);
+        let (a, b) = (c.eval(seg.t0).truncate(), c.eval(seg.t1).truncate());
+        Piece {
+            ends: if reversed { [b, a] } else { [a, b] },
+            seg,
+            reversed,
+        }
+    }
+
+    fn start(&self) -> DVec2 {
+        self.ends[0]
+    }
+
+    fn end(&self) -> DVec2 {
+        self.ends[1]
+    }
+
+    /// Moves the piece by `d`, exactly: each homogeneous point gains `w · d`.
+    fn shift(&mut self, d: DVec2) {
+        for p in &mut self.seg.curve.points {
+            p.x += p.z * d.x;
+            p.y += p.z * d.y;
+        }
+        self.ends = self.ends.map(|e| e + d);
+    }
+
+    /// Points along the piece, for its extent.
+    fn samples(&self) -> impl Iterator<Item = DVec2> + '_ {
+        let c = as_nurbs(&self.seg.curve);
+        let (t0, t1) = (self.seg.t0, self.seg.t1);
+        (0..=16).map(move |k| c.eval(t0 + (t1 - t0) * k as f64 / 16.0).truncate())
+    }
+}
+
+/// `x` moved by whole periods to lie nearest `near`.
+fn unwrap(x: f64, near: f64, period: Option<f64>) -> f64 {
+    match period {
+        Some(p) => x - ((x - near) / p).round() * p,
+        None => x,
+    }
+}
+
+/// The face's surface as far as the loops need it: its definition, its periods, and a
+/// point inverter for B-spline surfaces.
+struct Domain<'f> {
+    def: &'f SurfaceDef,
+    periods: [Option<f64>; 2],
+    inverter: Option<Inverter>,
+    /// Model-size length tolerance for chords and pcurve agreement.
+    scale: f64,
+}
+
+impl Domain<'_> {
+    fn point(&self, uv: DVec2) -> DVec3 {
+        self.def.point(uv.x, uv.y)
+    }
+
+    /// Parameters of `p`, unwrapped to lie nearest `near`.
+    fn uv(&self, p: DVec3, near: Option<DVec2>) -> Option<DVec2> {
+        let uv = match self.def.parameters_of(p) {
+            Some(uv) => uv,
+            None => {
+                let hit = self.inverter.as_ref()?.project(p)?;
+                DVec2::new(hit.u, hit.v)
+            }
+        };
+        Some(match near {
+            Some(n) => DVec2::new(
+                unwrap(uv.x, n.x, self.periods[0]),
+                unwrap(uv.y, n.y, self.periods[1]),
+            ),
+            None => uv,
+        })
+    }
+
+    /// Whether the periodic u collapses at `uv` (a sphere's pole, a cone's apex), where the
+    /// angle of a point means nothing.
+    fn collapsed_u(&self, uv: DVec2) -> bool {
+        self.periods[0].is_some()
+            && self
+                .point(uv)
+                .distance(self.point(uv + DVec2::new(1.0, 0.0)))
+                <= self.scale * CHORD_TOLERANCE
+    }
+
+    /// The projection of `c` over `[ta, tb]` into the parameter plane as a polyline refined
+    /// until every chord's midpoint maps within tolerance of the projected curve, and the
+    /// largest distance met between the edge and the surface or the chords and the
+    /// projection.
+    fn project(&self, c: &Curve, ta: f64, tb: f64) -> Result<(Vec<DVec2>, f64), String> {
+        let tol = self.scale * CHORD_TOLERANCE;
+        let mut worst: f64 = 0.0;
+        let mut measure = |t: f64, near: Option<DVec2>| -> Result<DVec2, String> {
+            let p = c.point(t);
+            let uv = self
+                .uv(p, near)
+                .ok_or_else(|| format!("cannot project the edge point {p} onto the surface"))?;
+            worst = worst.max(self.point(uv).distance(p));
+            Ok(uv)
+        };
+        let mut ts = Vec::new();
+        let mut uvs: Vec<DVec2> = Vec::new();
+        for k in 0..=MIN_SEGMENTS {
+            let t = ta + (tb - ta) * k as f64 / MIN_SEGMENTS as f64;
+            let uv = measure(t, uvs.last().copied())?;
+            ts.push(t);
+            uvs.push(uv);
+        }
+        // Refine: a stack of segments, left to right.
+        let mut out = vec![uvs[0]];
+        let mut stack: Vec<(f64, DVec2, f64, DVec2, usize)> = (0..MIN_SEGMENTS)
+            .rev()
+            .map(|k| (ts[k], uvs[k], ts[k + 1], uvs[k + 1], 0))
+            .collect();
+        let mut chord_worst: f64 = 0.0;
+        while let Some((t0, a, t1, b, depth)) = stack.pop() {
+            let tm = 0.5 * (t0 + t1);
+            let m = measure(tm, Some(a))?;
+            // The chord's error against the projected curve (the edge's own distance
+            // from the surface is the projection error, measured in `measure`).
+            let err = self.point(0.5 * (a + b)).distance(self.point(m));
+            if err > tol && depth < MAX_REFINE {
+                stack.push((tm, m, t1, b, depth + 1));
+                stack.push((t0, a, tm, m, depth + 1));
+            } else {
+                chord_worst = chord_worst.max(err);
+                out.push(b);
+            }
+        }
+        // Points at a pole take the angle of their neighbour along the edge.
+        for k in 0..out.len() {
+            if self.collapsed_u(out[k]) {
+                let neighbour = if k + 1 < out.len() && !self.collapsed_u(out[k + 1]) {
+                    Some(out[k + 1].x)
+                } else if k > 0 {
+                    Some(out[k - 1].x)
+                } else {
+                    None
+                };
+                if let Some(u) = neighbour {
+                    out[k].x = u;
+                }
+            }
+        }
+        Ok((out, worst.max(chord_worst)))
+    }
+
+    /// The pcurve `pc` over `[ta, tb]`, exact, if it agrees with the 3D curve there (its
+    /// parameter the 3D curve's, as ISO 10303-42 intends for surface curves).
+    fn pcurve_piece(&self, pc: &PCurve, c3: &Curve, ta: f64, tb: f64) -> Option<TrimSegment> {
+        let tol = self.scale * PCURVE_TOLERANCE;
+        let agrees = [ta, 0.5 * (ta + tb), tb].iter().all(|&t| {
+            self.point(pc.curve.point(t).truncate())
+                .distance(c3.point(t))
+                <= tol
+        });
+        if !agrees {
+            return None;
+        }
+        let (curve, _) = curve_to_nurbs(&pc.curve, [ta, tb]).ok()?;
+        let (d0, d1) = crate::geom::nurbs::knots::domain(curve.degree, &curve.knots);
+        Some(TrimSegment {
+            t0: ta.max(d0),
+            t1: tb.min(d1),
+            curve: as_param(&curve),
+        })
+    }
+}
+
+/// The parameter interval `[ta, tb]` of the edge on its 3D curve (increasing) and whether
+/// the edge runs along the curve: vertices located on the curve, periodic curves
+/// unwrapped, a closed edge taking a whole period (or the whole B-spline).
+fn edge_interval(e: &Edge) -> (f64, f64) {
+    let c = e.curve.space_curve();
+    let (ps, pe) = (c.parameter_of(e.start), c.parameter_of(e.end));
+    let (a, mut b) = if e.same_sense { (ps, pe) } else { (pe, ps) };
+    match c.period() {
+        Some(p) if matches!(c, Curve::Circle { .. } | Curve::Ellipse { .. }) => {
+            b = a + (b - a).rem_euclid(p);
+            if e.closed || b - a <= p * 1e-12 {
+                b = a + p;
+            }
+            (a, b)
+        }
+        _ => {
+            if e.closed {
+                let (d0, d1) = c.domain();
+                if d0.is_finite() && d1.is_finite() {
+                    return (d0, d1);
+                }
+            }
+            (a.min(b), a.max(b))
+        }
+    }
+}
+
+/// Converts one face; the error says why it could not be (the caller names the face).
+pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
+    let def = &*face.surface;
+    let inverter = match def {
+        SurfaceDef::BSpline(n) => Some(Inverter::new(n)),
+        _ => None,
+    };
+    let dom = Domain {
+        def,
+        periods: def.periods(),
+        inverter,
+        scale,
+    };
+    let mut projection_error: f64 = 0.0;
+    let mut projected_edges = 0;
+    // Each edge's candidate pieces, once per face (a seam edge appears twice in a loop).
+    let mut candidates: HashMap<u64, Vec<TrimSegment>> = HashMap::new();
+    let mut loops: Vec<(Vec<Piece>, Option<usize>)> = Vec::new();
+    let mut extent_points: Vec<DVec2> = Vec::new();
+    let mut outer_u: Option<(f64, f64)> = None;
+    let outer_index = face.bounds.iter().position(|b| b.outer).unwrap_or(0);
+    let mut order: Vec<usize> = (0..face.bounds.len()).collect();
+    order.retain(|&k| k != outer_index);
+    order.insert(0, outer_index.min(face.bounds.len().saturating_sub(1)));
+    for &bi in order.iter().take(face.bounds.len()) {
+        let bound = &face.bounds[bi];
+        if bound.edges.is_empty() {
+            if let Some(p) = bound.vertex {
+                let near = extent_points.last().copied();
+                if let Some(uv) = dom.uv(p, near) {
+                    extent_points.push(uv);
+                }
+            }
+            continue;
+        }
+        let mut pieces: Vec<Piece> = Vec::new();
+        let mut used: HashMap<u64, usize> = HashMap::new();
+        for oe in &bound.edges {
+            let e = &oe.edge;
+            let (ta, tb) = edge_interval(e);
+            if !(ta.is_finite() && tb.is_finite() && ta < tb) {
+                return Err(format!("edge #{} has an empty parameter range", e.id));
+            }
+            if let std::collections::hash_map::Entry::Vacant(slot) = candidates.entry(e.id) {
+                let c3 = e.curve.space_curve();
+                let mut list = Vec::new();
+                if let Curve::OnSurface { pcurves, .. } = &*e.curve {
+                    for pc in pcurves.iter().filter(|pc| pc.surface == face.surface_id) {
+                        if let Some(seg) = dom.pcurve_piece(pc, c3, ta, tb) {
+                            list.push(seg);
+                        }
+                    }
+                }
+                if list.is_empty() {
+                    let (points, err) = dom
+                        .project(c3, ta, tb)
+                        .map_err(|m| format!("edge #{}: {m}", e.id))?;
+                    projection_error = projection_error.max(err);
+                    projected_edges += 1;
+                    list.push(TrimSegment::polyline(&points));
+                }
+                slot.insert(list);
+            }
+            let list = &candidates[&e.id];
+            let reversed = oe.orientation != e.same_sense;
+            let prev_end = pieces.last().map(Piece::end);
+            let placed = |k: usize| -> Piece {
+                let mut p = Piece::new(list[k].clone(), reversed);
+                if let Some(end) = prev_end {
+                    let s = p.start();
+                    let du = if dom.collapsed_u(end) {
+                        0.0
+                    } else {
+                        unwrap(s.x, end.x, dom.periods[0]) - s.x
+                    };
+                    let dv = unwrap(s.y, end.y, dom.periods[1]) - s.y;
+                    p.shift(DVec2::new(du, dv));
+                }
+                p
+            };
+            let k = match (used.get(&e.id), prev_end) {
+                (Some(&k0), _) if list.len() > 1 => 1 - k0.min(1),
+                (_, Some(end)) => (0..list.len())
+                    .min_by(|&a, &b| {
+                        placed(a)
+                            .start()
+                            .distance(end)
+                            .total_cmp(&placed(b).start().distance(end))
+                    })
+                    .unwrap_or(0),
+                _ => 0,
+            };
+            used.insert(e.id, k);
+            let piece = placed(k);
+            // A gap in the domain where the 3D loop is continuous: a pole or apex, or a
+            // file's tolerance; bridge it so the loop stays closed.
+            if let Some(end) = prev_end
+                && piece.start().distance(end) > 1e-9 * (1.0 + end.length())
+            {
+                pieces.push(Piece::new(
+                    TrimSegment::polyline(&[end, piece.start()]),
+                    false,
+                ));
+            }
+            pieces.push(piece);
+        }
+        // Holes first placed within the outer loop's periodic range.
+        if let (Some((u0, _)), Some(period)) = (outer_u, dom.periods[0]) {
+            let s = pieces[0].start().x;
+            let d = u0 + (s - u0).rem_euclid(period) - s;
+            for p in &mut pieces {
+                p.shift(DVec2::new(d, 0.0));
+            }
+        }
+        let (first, last) = (pieces[0].start(), pieces[pieces.len() - 1].end());
+        let gap = first - last;
+        let winds = (0..2).find(|&axis| {
+            dom.periods[axis].is_some_and(|p| {
+                (gap[axis].abs() - p).abs() <= 1e-9 * p
+                    && gap[1 - axis].abs() <= 1e-9 * (1.0 + last.length())
+            })
+        });
+        if winds.is_none() && gap.length() > 1e-9 * (1.0 + last.length()) {
+            pieces.push(Piece::new(TrimSegment::polyline(&[last, first]), false));
+        }
+        let mut lo = f64::INFINITY;
+        let mut hi = f64::NEG_INFINITY;
+        for p in &pieces {
+            for q in p.samples() {
+                lo = lo.min(q.x);
+                hi = hi.max(q.x);
+                extent_points.push(q);
+            }
+        }
+        if outer_u.is_none() {
+            outer_u = Some((lo, hi));
+        }
+        loops.push((pieces, winds));
+    }
+    // The surface over the loops' extent (B-splines keep their own domain).
+    let mut lo = DVec2::splat(f64::INFINITY);
+    let mut hi = DVec2::splat(f64::NEG_INFINITY);
+    for q in &extent_points {
+        lo = lo.min(*q);
+        hi = hi.max(*q);
+    }
+    if matches!(def, SurfaceDef::BSpline(_)) {
+        let d = match def {
+            SurfaceDef::BSpline(n) => n.domain(),
+            _ => unreachable!(),
+        };
+        lo = DVec2::new(d.u0, d.v0);
+        hi = DVec2::new(d.u1, d.v1);
+    } else if !(lo.x < hi.x && lo.y < hi.y) {
+        return Err(
+            "its bounds enclose no area of the surface (an unbounded or degenerate face)".into(),
+        );
+    }
+    for axis in 0..2 {
+        if let Some(p) = dom.periods[axis] {
+            hi[axis] = hi[axis].min(lo[axis] + p);
+        }
+    }
+    if let SurfaceDef::Sphere { .. } = def {
+        lo.y = lo.y.max(-std::f64::consts::FRAC_PI_2);
+        hi.y = hi.y.min(std::f64::consts::FRAC_PI_2);
+    }
+    let (nurbs, trim_space) =
+        surface_to_nurbs(def, [lo.x, hi.x], [lo.y, hi.y]).map_err(|e| e.to_string())?;
+    // Winding loops close beyond the other parameter's range, all on the same side.
+    let mut trims = Vec::new();
+    for (k, (mut pieces, winds)) in loops.into_iter().enumerate() {
+        if let Some(axis) = winds {
+            let other = 1 - axis;
+            let far = hi[other] + (hi[other] - lo[other]).max(1.0);
+            let (first, last) = (pieces[0].start(), pieces[pieces.len() - 1].end());
+            let mut a = last;
+            a[other] = far;
+            let mut b = first;
+            b[other] = far;
+            pieces.push(Piece::new(
+                TrimSegment::polyline(&[last, a, b, first]),
+                false,
+            ));
+        }
+        trims.push(TrimLoop {
+            hole: k > 0,
+            // A segment runs from t0 to t1 in either order (`geom::trim`): reversed
+            // pieces swap them, so each segment starts where the previous one ended.
+            segments: pieces
+                .into_iter()
+                .map(|p| match p.reversed {
+                    false => p.seg,
+                    true => TrimSegment {
+                        t0: p.seg.t1,
+                        t1: p.seg.t0,
+                        curve: p.seg.curve,
+                    },
+                })
+                .collect(),
+        });
+    }
+    Ok(FaceOutcome {
+        surface: Surface {
+            geometry: SurfaceGeometry::Nurbs(nurbs),
+            trims,
+            trim_space,
+        },
+        projection_error,
+        projected_edges,
+    })
+}

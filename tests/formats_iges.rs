@@ -1,0 +1,647 @@
+//! IGES reading (issue 16). Small files are written here by a minimal IGES writer, one
+//! per entity kind, and the converted surfaces and trims are checked at sample points
+//! against the entity's definition evaluated independently in f64 (a recursive Cox–de Boor,
+//! rotation by quaternion, the polynomials of a 112) to 1e-12 of the model's size. The
+//! hammer read from IGES is compared with the same geometry read from OBJ.
+
+use std::f64::consts::PI;
+use std::path::Path;
+
+use glam::{DQuat, DVec2, DVec3};
+use patchtrace::geom::nurbs::NurbsSurface;
+use patchtrace::geom::trim::{ParamCurve, TrimLoop};
+use patchtrace::scene::iges::{Iges, parse_iges};
+use patchtrace::scene::model::{Surface, SurfaceGeometry};
+
+mod iges_support;
+use iges_support::{Entry, fixed_format};
+
+const REL: f64 = 1e-12;
+
+// ---------------------------------------------------------------------------------------
+// Entities for the writer in `iges_support`.
+
+struct Ent {
+    ty: i32,
+    form: i32,
+    params: Vec<String>,
+    transform: usize,
+    colour: i64,
+    /// Status digits 3–4: 0 independent, 1 physically dependent.
+    subordinate: u8,
+}
+
+fn ent(ty: i32, params: &[f64]) -> Ent {
+    Ent {
+        ty,
+        form: 0,
+        params: params.iter().map(|&p| number(p)).collect(),
+        transform: 0,
+        colour: 0,
+        subordinate: 1,
+    }
+}
+
+/// Integral values as IGES integers (readers take them for reals too), others as reals
+/// with an exponent.
+fn number(p: f64) -> String {
+    if p.fract() == 0.0 && p.abs() < 1e9 {
+        format!("{}", p as i64)
+    } else {
+        format!("{p:e}").replace('e', "E")
+    }
+}
+
+/// A pointer to the k-th entity (0-based).
+fn de(k: usize) -> f64 {
+    (2 * k + 1) as f64
+}
+
+fn write_iges(ents: &[Ent]) -> String {
+    let global = ",,4Htest,8Htest.igs,2Hpt,2Hpt,32,38,6,308,15,4Htest,1.,2,2HMM,1,0.1,\
+                  13H260101.000000,1.E-6,100.,2Hme,2Hus,11,0;";
+    let entries: Vec<Entry> = ents
+        .iter()
+        .map(|e| Entry {
+            ty: e.ty,
+            form: e.form,
+            fields: e.params.clone(),
+            transform: e.transform,
+            colour: e.colour,
+            status: format!("00{:02}0000", e.subordinate),
+        })
+        .collect();
+    fixed_format(global, &entries)
+}
+
+fn read(ents: &[Ent]) -> Iges {
+    let text = write_iges(ents);
+    parse_iges(Path::new("test.igs"), &text).unwrap_or_else(|e| panic!("{e}\n{text}"))
+}
+
+/// The one drawn surface, with no conversion failures.
+fn only(read: &Iges) -> (&NurbsSurface, &Surface) {
+    assert!(read.report.failed.is_empty(), "{:?}", read.report.failed);
+    assert_eq!(read.surfaces.len(), 1);
+    let s = &read.surfaces[0].surface;
+    let SurfaceGeometry::Nurbs(n) = &s.geometry else {
+        panic!("a NURBS surface")
+    };
+    (n, s)
+}
+
+fn close(a: DVec3, b: DVec3, scale: f64, what: &str) {
+    let e = (a - b).length();
+    assert!(e <= REL * scale, "{what}: {a} vs {b} ({e:e})");
+}
+
+// ---------------------------------------------------------------------------------------
+// Independent evaluation: the Cox–de Boor recursion as written in The NURBS Book eq. 2.5.
+
+fn basis(i: usize, p: usize, knots: &[f64], t: f64) -> f64 {
+    if p == 0 {
+        let last = knots[knots.len() - 1];
+        let inside = knots[i] <= t && t < knots[i + 1];
+        // The closed right end belongs to the last non-empty span.
+        let end = t == last && knots[i] < knots[i + 1] && knots[i + 1] == last;
+        return if inside || end { 1.0 } else { 0.0 };
+    }
+    let mut v = 0.0;
+    let d1 = knots[i + p] - knots[i];
+    if d1 > 0.0 {
+        v += (t - knots[i]) / d1 * basis(i, p - 1, knots, t);
+    }
+    let d2 = knots[i + p + 1] - knots[i + 1];
+    if d2 > 0.0 {
+        v += (knots[i + p + 1] - t) / d2 * basis(i + 1, p - 1, knots, t);
+    }
+    v
+}
+
+/// A rational B-spline curve point from Euclidean points and weights.
+fn curve_point(p: usize, knots: &[f64], points: &[DVec3], weights: &[f64], t: f64) -> DVec3 {
+    let (mut num, mut den) = (DVec3::ZERO, 0.0);
+    for (i, (q, w)) in points.iter().zip(weights).enumerate() {
+        let b = basis(i, p, knots, t) * w;
+        num += *q * b;
+        den += b;
+    }
+    num / den
+}
+
+/// A trim curve's point at t, from its homogeneous (w u, w v, w) points.
+fn trim_point(c: &ParamCurve, t: f64) -> DVec2 {
+    let pts: Vec<DVec3> = c
+        .points
+        .iter()
+        .map(|q| DVec3::new(q.x / q.z, q.y / q.z, 0.0))
+        .collect();
+    let w: Vec<f64> = c.points.iter().map(|q| q.z).collect();
+    curve_point(c.degree, &c.knots, &pts, &w, t).truncate()
+}
+
+/// Entity 126 parameters for a curve (planar flag 0, V range = the knot domain).
+fn b126(p: usize, knots: &[f64], points: &[DVec3], weights: &[f64]) -> Vec<f64> {
+    let k = points.len() - 1;
+    let mut v = vec![k as f64, p as f64, 0.0, 0.0, 0.0, 0.0];
+    v.extend(knots);
+    v.extend(weights);
+    for q in points {
+        v.extend([q.x, q.y, q.z]);
+    }
+    v.extend([knots[p], knots[knots.len() - p - 1], 0.0, 0.0, 1.0]);
+    v
+}
+
+/// A 128: degree (2, 1), a rational net with an interior u knot.
+struct Net {
+    ku: Vec<f64>,
+    kv: Vec<f64>,
+    pts: Vec<DVec3>,
+    w: Vec<f64>,
+}
+
+fn net() -> Net {
+    let mut pts = Vec::new();
+    let mut w = Vec::new();
+    for j in 0..2 {
+        for i in 0..4 {
+            pts.push(DVec3::new(
+                i as f64,
+                2.0 * j as f64,
+                (i * j) as f64 * 0.3 + 0.1 * i as f64,
+            ));
+            w.push(1.0 + 0.25 * ((i + 2 * j) % 3) as f64);
+        }
+    }
+    Net {
+        ku: vec![0., 0., 0., 0.5, 1., 1., 1.],
+        kv: vec![0., 0., 1., 1.],
+        pts,
+        w,
+    }
+}
+
+fn b128(n: &Net, range: [f64; 4]) -> Vec<f64> {
+    let mut v = vec![3.0, 1.0, 2.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+    v.extend(&n.ku);
+    v.extend(&n.kv);
+    v.extend(&n.w);
+    for q in &n.pts {
+        v.extend([q.x, q.y, q.z]);
+    }
+    v.extend(range);
+    v
+}
+
+fn net_point(n: &Net, u: f64, v: f64) -> DVec3 {
+    let (mut num, mut den) = (DVec3::ZERO, 0.0);
+    for j in 0..2 {
+        for i in 0..4 {
+            let b = basis(i, 2, &n.ku, u) * basis(j, 1, &n.kv, v) * n.w[j * 4 + i];
+            num += n.pts[j * 4 + i] * b;
+            den += b;
+        }
+    }
+    num / den
+}
+
+fn grid() -> impl Iterator<Item = (f64, f64)> {
+    (0..=10).flat_map(|i| (0..=10).map(move |j| (i as f64 / 10.0, j as f64 / 10.0)))
+}
+
+#[test]
+fn b_spline_surface_with_transform_colour_and_parameter_space_trims() {
+    let n = net();
+    // 0: 128; 1: 124 (rotation about z by 30° and a translation); 2: 314;
+    // 3–6: 110 lines of the outer square in (u, v); 7: 102; 8: 142 outer;
+    // 9: 100 circle hole; 10: 142 hole; 11: 144.
+    let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+    let mut surf = ent(128, &b128(&n, [0.0, 1.0, 0.0, 1.0]));
+    surf.transform = 3;
+    // Marked independent, as some writers do: still drawn only through the 144.
+    surf.subordinate = 0;
+    let square = [(0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.1, 0.9), (0.1, 0.1)];
+    let mut ents = vec![
+        surf,
+        ent(124, &[c, -s, 0.0, 1.0, s, c, 0.0, -2.0, 0.0, 0.0, 1.0, 0.5]),
+        ent(314, &[20.0, 40.0, 80.0]),
+    ];
+    for w in square.windows(2) {
+        ents.push(ent(110, &[w[0].0, w[0].1, 0.0, w[1].0, w[1].1, 0.0]));
+    }
+    ents.push(ent(102, &[4.0, de(3), de(4), de(5), de(6)]));
+    ents.push(ent(142, &[0.0, de(0), de(7), 0.0, 1.0]));
+    ents.push(ent(100, &[0.0, 0.5, 0.5, 0.7, 0.5, 0.7, 0.5]));
+    ents.push(ent(142, &[0.0, de(0), de(9), 0.0, 1.0]));
+    let mut top = ent(144, &[de(0), 1.0, 1.0, de(8), de(10)]);
+    top.subordinate = 0;
+    top.colour = -(de(2) as i64);
+    ents.push(top);
+    let read = read(&ents);
+    let (nurbs, surface) = only(&read);
+    let m = glam::DAffine3::from_mat3_translation(
+        glam::DMat3::from_cols(DVec3::new(c, s, 0.0), DVec3::new(-s, c, 0.0), DVec3::Z),
+        DVec3::new(1.0, -2.0, 0.5),
+    );
+    for (u, v) in grid() {
+        close(
+            nurbs.eval(u, v),
+            m.transform_point3(net_point(&n, u, v)),
+            8.0,
+            "128",
+        );
+    }
+    let colour = read.surfaces[0].colour.unwrap();
+    assert!((colour - DVec3::new(0.2, 0.4, 0.8)).length() < 1e-15);
+    let [outer, hole]: &[TrimLoop; 2] = surface.trims.as_slice().try_into().unwrap();
+    assert!(!outer.hole && hole.hole);
+    assert_eq!(outer.segments.len(), 4);
+    for (k, seg) in outer.segments.iter().enumerate() {
+        let (a, b) = (DVec2::from(square[k]), DVec2::from(square[k + 1]));
+        for i in 0..=4 {
+            let t = seg.t0 + (seg.t1 - seg.t0) * i as f64 / 4.0;
+            let want = a.lerp(b, (t - seg.t0) / (seg.t1 - seg.t0));
+            assert!((trim_point(&seg.curve, t) - want).length() < REL);
+        }
+    }
+    let circle = &hole.segments[0];
+    assert!(
+        (circle.t1 - circle.t0 - 2.0 * PI).abs() < 1e-15,
+        "a full turn"
+    );
+    for i in 0..=16 {
+        let t = circle.t0 + (circle.t1 - circle.t0) * i as f64 / 16.0;
+        let r = (trim_point(&circle.curve, t) - DVec2::splat(0.5)).length();
+        assert!((r - 0.2).abs() < REL, "radius {r}");
+    }
+}
+
+#[test]
+fn narrower_parameter_range_becomes_an_outer_loop_and_units_are_read() {
+    let n = net();
+    let mut surf = ent(128, &b128(&n, [0.25, 0.75, 0.0, 1.0]));
+    surf.subordinate = 0;
+    let read = read(&[surf]);
+    let (_, s) = only(&read);
+    assert_eq!(s.trims.len(), 1);
+    let seg = &s.trims[0].segments[0];
+    let corners: Vec<DVec2> = (0..5).map(|i| trim_point(&seg.curve, i as f64)).collect();
+    assert_eq!(corners[0], DVec2::new(0.25, 0.0));
+    assert_eq!(corners[2], DVec2::new(0.75, 1.0));
+    assert_eq!(read.report.units, "MM");
+    assert!(read.report.lines()[0].contains("MM"));
+}
+
+/// Rotation of `p` about the line through `a` along `d` by `angle` (quaternion, f64).
+fn rotate(p: DVec3, a: DVec3, d: DVec3, angle: f64) -> DVec3 {
+    a + DQuat::from_axis_angle(d.normalize(), angle) * (p - a)
+}
+
+#[test]
+fn surface_of_revolution_of_a_line_and_of_an_arc() {
+    let (a0, a1) = (DVec3::new(0.0, 0.0, -1.0), DVec3::new(0.2, 0.1, 3.0));
+    let (l0, l1) = (DVec3::new(1.0, 0.0, 0.0), DVec3::new(2.0, 0.5, 2.0));
+    let (sa, ta) = (0.3, 2.0 * PI - 0.2);
+    let mut rev = ent(120, &[de(0), de(1), sa, ta]);
+    rev.subordinate = 0;
+    let read_line = read(&[
+        ent(110, &[a0.x, a0.y, a0.z, a1.x, a1.y, a1.z]),
+        ent(110, &[l0.x, l0.y, l0.z, l1.x, l1.y, l1.z]),
+        rev,
+    ]);
+    let (s, surface) = only(&read_line);
+    for (u, v) in grid() {
+        let d = s.domain();
+        let (u, v) = d.to_parent(u, v);
+        let (t, theta) = (
+            surface.trim_space[0].apply(u),
+            surface.trim_space[1].apply(v),
+        );
+        let want = rotate(l0.lerp(l1, t), a0, a1 - a0, theta);
+        close(s.eval(u, v), want, 4.0, "120 line");
+    }
+    // Generatrix: the arc of radius 0.5 about (1.5, 0) in the xz plane from angle 0 to
+    // 180°, made by a 124 that maps the arc's xy plane to xz.
+    let mut arc = ent(100, &[0.0, 1.5, 0.0, 2.0, 0.0, 1.0, 0.0]);
+    arc.transform = 7;
+    let mut rev = ent(120, &[de(0), de(1), 0.0, PI]);
+    rev.subordinate = 0;
+    let read_arc = read(&[
+        ent(110, &[0.0, 0.0, 0.0, 0.0, 0.0, 1.0]),
+        arc,
+        rev,
+        ent(
+            124,
+            &[1.0, 0.0, 0.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 1.0, 0.0, 0.0],
+        ),
+    ]);
+    let (s, surface) = only(&read_arc);
+    for (u, v) in grid() {
+        let (u, v) = s.domain().to_parent(u, v);
+        let (t, theta) = (
+            surface.trim_space[0].apply(u),
+            surface.trim_space[1].apply(v),
+        );
+        let p = DVec3::new(1.5 + 0.5 * t.cos(), 0.0, 0.5 * t.sin());
+        close(
+            s.eval(u, v),
+            rotate(p, DVec3::ZERO, DVec3::Z, theta),
+            2.0,
+            "120 arc",
+        );
+    }
+}
+
+#[test]
+fn tabulated_cylinder_of_a_b_spline_and_its_trims() {
+    let pts = [
+        DVec3::new(0., 0., 0.),
+        DVec3::new(1., 2., 0.),
+        DVec3::new(3., -1., 0.5),
+        DVec3::new(4., 0., 0.),
+    ];
+    let w = [1.0, 0.5, 2.0, 1.0];
+    let knots = [1.0, 1.0, 1.0, 2.0, 3.0, 3.0, 3.0];
+    let end = DVec3::new(0.5, 0.5, 3.0);
+    // 0: 126 directrix on t in [1, 3]; 1: 122; 2: 110 trim line in (u, v); 3: 142; 4: 144.
+    let mut top = ent(144, &[de(1), 1.0, 0.0, de(3)]);
+    top.subordinate = 0;
+    let read = read(&[
+        ent(126, &b126(2, &knots, &pts, &w)),
+        ent(122, &[de(0), end.x, end.y, end.z]),
+        ent(110, &[0.0, 0.0, 0.0, 1.0, 0.5, 0.0]),
+        ent(142, &[0.0, de(1), de(2), 0.0, 1.0]),
+        top,
+    ]);
+    let (s, surface) = only(&read);
+    let c = |t: f64| curve_point(2, &knots, &pts, &w, t);
+    for (u, v) in grid() {
+        let (u, v) = s.domain().to_parent(u, v);
+        let t = surface.trim_space[0].apply(u);
+        close(s.eval(u, v), c(t) + (end - c(1.0)) * v, 5.0, "122");
+    }
+    // The trim (u, v) = (0, 0) → (1, 0.5) in the 122's normalised u lands at t = 1 → 3.
+    let seg = &surface.trims[0].segments[0];
+    assert!((trim_point(&seg.curve, seg.t0) - DVec2::new(1.0, 0.0)).length() < REL);
+    assert!((trim_point(&seg.curve, seg.t1) - DVec2::new(3.0, 0.5)).length() < REL);
+}
+
+#[test]
+fn ruled_surface_between_a_line_and_a_cubic() {
+    let pts = [
+        DVec3::new(0., 1., 0.),
+        DVec3::new(1., 2., 1.),
+        DVec3::new(2., 1., 0.),
+        DVec3::new(3., 2., 1.),
+    ];
+    let knots = [0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+    let mut ruled = ent(118, &[de(0), de(1), 0.0, 0.0]);
+    ruled.form = 1;
+    ruled.subordinate = 0;
+    let read = read(&[
+        ent(110, &[0.0, 0.0, 0.0, 3.0, 0.0, 0.0]),
+        ent(126, &b126(3, &knots, &pts, &[1.0; 4])),
+        ruled,
+    ]);
+    let (s, _) = only(&read);
+    for (u, v) in grid() {
+        let line = DVec3::new(3.0 * u, 0.0, 0.0);
+        let cubic = curve_point(3, &knots, &pts, &[1.0; 4], u);
+        close(s.eval(u, v), line * (1.0 - v) + cubic * v, 3.0, "118");
+    }
+}
+
+#[test]
+fn bounded_plane_and_copious_data() {
+    // 108 form 1 (A, B, C, D) bounded by a closed 106 form 63 polygon in the plane.
+    let (nrm, d) = (DVec3::new(1.0, 2.0, 2.0), 3.0);
+    let poly = [
+        DVec3::new(3.0, 0.0, 0.0),
+        DVec3::new(1.0, 1.0, 0.0),
+        DVec3::new(-1.0, 0.0, 2.0),
+        DVec3::new(3.0, 0.0, 0.0),
+    ];
+    let mut copious = vec![2.0, poly.len() as f64];
+    for p in &poly {
+        assert_eq!(p.dot(nrm), d);
+        copious.extend([p.x, p.y, p.z]);
+    }
+    let mut cop = ent(106, &copious);
+    cop.form = 63;
+    let mut plane = ent(108, &[nrm.x, nrm.y, nrm.z, d, de(0), 0.0, 0.0, 0.0, 1.0]);
+    plane.form = 1;
+    plane.subordinate = 0;
+    let read = read(&[cop, plane]);
+    let (s, surface) = only(&read);
+    for (u, v) in grid() {
+        let (u, v) = s.domain().to_parent(u, v);
+        assert!((s.eval(u, v).dot(nrm) - d).abs() < REL * 9.0);
+    }
+    // The loop's vertices are the polygon's, in the plane patch's own (u, v).
+    let seg = &surface.trims[0].segments[0];
+    for (i, p) in poly.iter().enumerate() {
+        let uv = trim_point(&seg.curve, i as f64);
+        close(s.eval(uv.x, uv.y), *p, 3.0, "106 vertex");
+    }
+}
+
+#[test]
+fn parametric_spline_and_ellipse_as_trims_and_a_projected_model_space_curve() {
+    let n = net();
+    // 1: 112 of two cubic segments as the outer loop's parameter curve; 3: 104 ellipse
+    // (x − 0.5)²/0.04 + (y − 0.5)²/0.01 = 1 in general form, as a hole; 5: 110 model-space
+    // line on the surface, only in model space (projected).
+    let seg = |a: [f64; 4], b: [f64; 4]| [a, b, [0.0; 4]].concat();
+    let s0 = seg([0.1, 0.8, 0.0, 0.0], [0.1, 0.0, 2.0, -2.0]);
+    let s1 = seg([0.9, -0.8, 0.0, 0.0], [0.1, 0.4, 0.0, 0.0]);
+    let mut p112 = vec![3.0, 2.0, 2.0, 2.0, 0.0, 1.0, 3.0];
+    p112.extend(&s0);
+    p112.extend(&s1);
+    p112.extend([0.0; 12]);
+    let (a, c, dd, e, f) = (25.0, 100.0, -25.0, -100.0, 25.0 * 0.25 + 100.0 * 0.25 - 1.0);
+    let mut top = ent(144, &[de(0), 1.0, 2.0, de(2), de(4), de(7)]);
+    top.subordinate = 0;
+    let read = read(&[
+        ent(128, &b128(&n, [0.0, 1.0, 0.0, 1.0])),
+        ent(112, &p112),
+        ent(142, &[0.0, de(0), de(1), 0.0, 1.0]),
+        ent(104, &[a, 0.0, c, dd, e, f, 0.0, 0.7, 0.5, 0.7, 0.5]),
+        ent(142, &[0.0, de(0), de(3), 0.0, 1.0]),
+        // The u = 0 edge is the straight segment P00 → P01 (degree 1 in v).
+        ent(
+            110,
+            &[
+                n.pts[0].x, n.pts[0].y, n.pts[0].z, n.pts[4].x, n.pts[4].y, n.pts[4].z,
+            ],
+        ),
+        // A null entity (type 0), physically dependent: neither drawn nor counted.
+        ent(0, &[]),
+        ent(142, &[0.0, de(0), 0.0, de(5), 2.0]),
+        top,
+    ]);
+    let (_, surface) = only(&read);
+    let [outer, ellipse, projected]: &[TrimLoop; 3] = surface.trims.as_slice().try_into().unwrap();
+    assert!(!outer.hole && ellipse.hole && projected.hole);
+    let poly = |k: [f64; 4], s: f64| k[0] + k[1] * s + k[2] * s * s + k[3] * s * s * s;
+    let seg112 = &outer.segments[0];
+    for i in 0..=20 {
+        let t = 3.0 * i as f64 / 20.0;
+        let (k, s) = if t <= 1.0 { (&s0, t) } else { (&s1, t - 1.0) };
+        let want = DVec2::new(
+            poly(k[0..4].try_into().unwrap(), s),
+            poly(k[4..8].try_into().unwrap(), s),
+        );
+        assert!(
+            (trim_point(&seg112.curve, t) - want).length() < REL,
+            "t = {t}"
+        );
+    }
+    let es = &ellipse.segments[0];
+    for i in 0..=16 {
+        let t = es.t0 + (es.t1 - es.t0) * i as f64 / 16.0;
+        let p = trim_point(&es.curve, t);
+        let q = a * p.x * p.x + c * p.y * p.y + dd * p.x + e * p.y + f;
+        assert!(q.abs() < 1e-11, "conic residual {q}");
+    }
+    // The projected u = 0 edge: every point at u = 0, v from 0 to 1.
+    assert_eq!(read.report.projected, 1);
+    assert!(read.report.max_projection_error < 1e-12);
+    let ps = &projected.segments[0];
+    for i in 0..=8 {
+        let t = ps.t0 + (ps.t1 - ps.t0) * i as f64 / 8.0;
+        let p = trim_point(&ps.curve, t);
+        assert!(
+            p.x.abs() < 1e-9 && (-1e-9..=1.0 + 1e-9).contains(&p.y),
+            "{p}"
+        );
+    }
+}
+
+#[test]
+fn unsupported_entities_are_counted_and_bad_surfaces_named() {
+    let mut offset = ent(140, &[0.0]);
+    offset.subordinate = 0;
+    let mut bad = ent(120, &[de(0), de(0), 0.0, 1.0]);
+    bad.subordinate = 0;
+    let read = read(&[offset, bad]);
+    assert_eq!(
+        read.report.ignored_line().unwrap(),
+        "ignored: 1 × entity 140 (offset surface)"
+    );
+    assert_eq!(read.report.failed.len(), 1);
+    assert!(
+        read.report.failed[0].starts_with("entity 120 (D 3): "),
+        "{:?}",
+        read.report.failed
+    );
+}
+
+#[test]
+fn syntax_errors_are_located() {
+    let text = write_iges(&[ent(110, &[0.0, 0.0, 0.0, 1.0, 1.0, 1.0])]);
+    let text = text.replacen("1,1,1;", "1,x,1;", 1);
+    let line = 1 + text.lines().position(|l| l.starts_with("110,")).unwrap();
+    let e = parse_iges(Path::new("bad.igs"), &text).err().unwrap();
+    assert_eq!((e.line, e.column), (line, 13), "{e}");
+    assert!(e.to_string().contains("expected a number"), "{e}");
+    let text = write_iges(&[ent(110, &[0.0, 0.0, 0.0, 1.0, 1.0])]);
+    let e = parse_iges(Path::new("short.igs"), &text).err().unwrap();
+    assert_eq!(
+        e.message,
+        "parameter 6 of entity 110 (D 1): expected a real, found the end of its parameters"
+    );
+}
+
+fn external(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/testdata/external/gismo")
+        .join(name)
+}
+
+#[test]
+fn torus_igs_loads_one_closed_bicubic() {
+    let read = patchtrace::scene::iges::read_iges(&external("torus.igs")).unwrap();
+    let (n, s) = only(&read);
+    assert_eq!(
+        (n.degree_u, n.degree_v, n.count_u, n.count_v),
+        (3, 3, 7, 11)
+    );
+    assert!(s.trims.is_empty());
+    assert!(read.surfaces[0].colour.is_some());
+}
+
+#[test]
+fn hammer_from_iges_is_the_hammer_from_obj() {
+    let iges = patchtrace::scene::load_geometry(&external("hammer.iges")).unwrap();
+    let obj = patchtrace::scene::load_geometry(&external("hammer.from_iges.obj")).unwrap();
+    let (patchtrace::scene::Geometry::Surfaces(a), patchtrace::scene::Geometry::Surfaces(b)) =
+        (iges, obj)
+    else {
+        panic!("surfaces")
+    };
+    assert_eq!(a.len(), 45);
+    assert_eq!(a.len(), b.len());
+    // The OBJ holds 10 significant digits.
+    let rel = 1e-9;
+    let near = |x: f64, y: f64, scale: f64| (x - y).abs() <= rel * scale.max(x.abs());
+    for (k, (x, y)) in a.iter().zip(&b).enumerate() {
+        let (SurfaceGeometry::Nurbs(p), SurfaceGeometry::Nurbs(q)) = (&x.geometry, &y.geometry)
+        else {
+            panic!("NURBS")
+        };
+        // The OBJ restricts a surface to its `surf` range (knot insertion, exact), where
+        // the IGES reader keeps the whole 128 and makes a narrower parameter range an outer
+        // loop: compare the IGES surface restricted the same way.
+        let restricted;
+        let p = if (p.domain().u0 - q.domain().u0).abs() > rel * p.domain().u0.abs().max(1.0)
+            || (p.domain().u1 - q.domain().u1).abs() > rel * p.domain().u1.abs().max(1.0)
+            || (p.domain().v0 - q.domain().v0).abs() > rel * p.domain().v0.abs().max(1.0)
+            || (p.domain().v1 - q.domain().v1).abs() > rel * p.domain().v1.abs().max(1.0)
+        {
+            restricted = p.restricted(q.domain());
+            &restricted
+        } else {
+            p
+        };
+        assert_eq!(
+            (p.degree_u, p.degree_v, p.count_u, p.count_v),
+            (q.degree_u, q.degree_v, q.count_u, q.count_v),
+            "surface {k}"
+        );
+        for (s, t) in p
+            .knots_u
+            .iter()
+            .chain(&p.knots_v)
+            .zip(q.knots_u.iter().chain(&q.knots_v))
+        {
+            assert!(near(*s, *t, 10.0), "surface {k}: knot {s} vs {t}");
+        }
+        for (s, t) in p.points.iter().zip(&q.points) {
+            let (e, f) = (s.truncate() / s.w, t.truncate() / t.w);
+            assert!(
+                (e - f).length() <= rel * e.length().max(1.0) * 2.0,
+                "surface {k}: {e} vs {f}"
+            );
+            assert!(near(s.w, t.w, 1.0), "surface {k}: weight");
+        }
+        assert_eq!(x.trims.len(), y.trims.len(), "surface {k}");
+        for (l, m) in x.trims.iter().zip(&y.trims) {
+            assert_eq!(
+                (l.hole, l.segments.len()),
+                (m.hole, m.segments.len()),
+                "surface {k}"
+            );
+            for (s, t) in l.segments.iter().zip(&m.segments) {
+                assert!(near(s.t0, t.t0, 1.0) && near(s.t1, t.t1, 1.0));
+                assert_eq!(s.curve.points.len(), t.curve.points.len());
+                for (g, h) in s.curve.points.iter().zip(&t.curve.points) {
+                    assert!(
+                        (*g / g.z - *h / h.z).length() <= rel * 10.0,
+                        "surface {k}: trim {g} vs {h}"
+                    );
+                }
+            }
+        }
+    }
+}
