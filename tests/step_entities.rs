@@ -158,6 +158,45 @@ fn plane_face_matches_the_definition() {
     assert_eq!(s.trims.len(), 1);
 }
 
+/// A plane's edges map exactly through its frame: a circular hole (no pcurve) in a tilted
+/// plane becomes a rational loop whose every point lies at the circle's radius from its
+/// centre in the plane's parameters, to 1e-12 (a projected polyline's chords would fall
+/// inside by up to the chord tolerance).
+#[test]
+fn a_circle_on_a_plane_becomes_an_exact_rational_loop() {
+    let (o, zd, xd) = (
+        DVec3::new(1.0, 2.0, 3.0),
+        DVec3::ONE,
+        DVec3::new(1.0, -1.0, 0.0),
+    );
+    let (x, y, _) = frame(zd, xd);
+    let at = |u: f64, v: f64| o + u * x + v * y;
+    let (c, r) = (DVec2::new(0.5, 0.25), 0.75);
+    let mut w = StepWriter::default();
+    let ax = w.axis(o, zd, xd);
+    let plane = w.add(format!("PLANE('',#{ax})"));
+    let outer = w.polygon_bound(
+        &[at(-2.0, -2.0), at(2.0, -2.0), at(2.0, 2.0), at(-2.0, 2.0)],
+        true,
+    );
+    let hole = w.circle_bound(at(c.x, c.y), zd, DVec3::new(0.3, 0.7, -1.0), r, false);
+    w.face(&[outer, hole], plane);
+    let s = only_surface(&w.finish());
+    let hole = s.trims.iter().find(|l| l.hole).expect("the hole loop");
+    // Off the knots (a polyline's samples at its vertices would lie on the circle too).
+    let points = hole.segments.iter().flat_map(|seg| {
+        let c = as_curve(&seg.curve);
+        (0..997).map(move |k| {
+            c.eval(seg.t0 + (seg.t1 - seg.t0) * (k as f64 + 0.5) / 997.0)
+                .truncate()
+        })
+    });
+    for p in points {
+        let off = ((p - c).length() - r).abs();
+        assert!(off <= 1e-12, "a loop point {p} is {off} off the circle");
+    }
+}
+
 #[test]
 fn cylinder_face_with_arcs_and_lines() {
     let (o, r) = (DVec3::new(0.5, 0.0, -1.0), 2.0);
