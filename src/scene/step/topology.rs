@@ -246,7 +246,7 @@ impl Domain<'_> {
         let tol = self.scale * PCURVE_TOLERANCE;
         let mut points = Vec::with_capacity(curve.points.len());
         for p in &curve.points {
-            if !(p.w > 0.0) {
+            if p.w.is_nan() || p.w <= 0.0 {
                 return None;
             }
             let l = frame.local(p.truncate() / p.w);
