@@ -1,5 +1,5 @@
 //! The mutation run of issue 21, through the real binary: for every input format, valid
-//! files from `testdata/` (and the STEP test part, a GLB and a BVH file made by the binary
+//! files from `testdata/` (and its OpenCASCADE parts, the STEP test part, a GLB and a BVH file made by the binary
 //! at start) damaged by the structured mutations of `tests/mutate` (bytes flipped, lines
 //! dropped or repeated, numbers replaced by NaN, infinities, huge, tiny or empty values,
 //! truncation), each run through `info`, `convert` and a 16×16 `render` (ray files through
@@ -83,6 +83,17 @@ fn samples_with(ext: &str) -> Vec<Vec<u8>> {
     paths.iter().map(|p| std::fs::read(p).unwrap()).collect()
 }
 
+/// The real CAD files of `testdata/occ/` (written by OpenCASCADE) with extension `ext`.
+fn occ(ext: &str) -> Vec<Vec<u8>> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(testdata("occ"))
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == ext))
+        .collect();
+    paths.sort();
+    paths.iter().map(|p| std::fs::read(p).unwrap()).collect()
+}
+
 /// Runs the binary once to make an input the other formats cannot be mutated from.
 fn made_by_binary(dir: &Path, args: &[&str], out: &str) -> Vec<u8> {
     let path = dir.join(out);
@@ -134,8 +145,12 @@ fn formats(dir: &Path) -> Vec<Format> {
         scene("obj", "obj", samples_with("obj")),
         scene("pbrt", "pbrt", samples_with("pbrt")),
         scene("ron", "ron", samples_with("ron")),
-        scene("igs", "igs", samples_with("igs")),
-        scene("step", "step", vec![step_support::bracket(1).into_bytes()]),
+        scene("igs", "igs", [samples_with("igs"), occ("igs")].concat()),
+        scene(
+            "step",
+            "step",
+            [vec![step_support::bracket(1).into_bytes()], occ("step")].concat(),
+        ),
         scene("gltf", "gltf", samples_with("gltf")),
         scene("glb", "glb", vec![glb]),
         Format {
