@@ -73,8 +73,9 @@ fn testdata(name: &str) -> PathBuf {
         .join(name)
 }
 
-fn samples_with(ext: &str) -> Vec<Vec<u8>> {
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(testdata(""))
+/// The files with extension `ext` in `testdata/` (`dir` "") or one of its folders.
+fn files_in(dir: &str, ext: &str) -> Vec<Vec<u8>> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(testdata(dir))
         .unwrap()
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|e| e == ext))
@@ -83,15 +84,13 @@ fn samples_with(ext: &str) -> Vec<Vec<u8>> {
     paths.iter().map(|p| std::fs::read(p).unwrap()).collect()
 }
 
-/// The real CAD files of `testdata/occ/` (written by OpenCASCADE) with extension `ext`.
+fn samples_with(ext: &str) -> Vec<Vec<u8>> {
+    files_in("", ext)
+}
+
+/// The real CAD files of `testdata/occ/` (written by OpenCASCADE).
 fn occ(ext: &str) -> Vec<Vec<u8>> {
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(testdata("occ"))
-        .unwrap()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == ext))
-        .collect();
-    paths.sort();
-    paths.iter().map(|p| std::fs::read(p).unwrap()).collect()
+    files_in("occ", ext)
 }
 
 /// Runs the binary once to make an input the other formats cannot be mutated from.
