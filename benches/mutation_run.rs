@@ -36,6 +36,9 @@ const HEAVY_KB: u64 = 2 * 1024 * 1024;
 /// The backstop after which a run is killed (and counted as slow).
 const KILL_AFTER_S: u32 = 30;
 
+/// The 16×16 render, quiet, to a PNG beside the mutant.
+const TINY_RENDER: [&str; 7] = ["--width", "16", "--height", "16", "-q", "-o", "{out}.png"];
+
 /// How one format's mutants are run: the argument lists, with `{}` for the mutant and
 /// `{out}` for an output path in the mutant's directory.
 struct Format {
@@ -111,17 +114,7 @@ fn formats(dir: &Path) -> Vec<Format> {
         vec![
             vec!["info", "{}"],
             vec!["convert", "{}", "-o", "{out}.ron"],
-            vec![
-                "render",
-                "{}",
-                "--width",
-                "16",
-                "--height",
-                "16",
-                "-q",
-                "-o",
-                "{out}.png",
-            ],
+            [&["render", "{}"][..], &TINY_RENDER].concat(),
         ]
     };
     let teapot = testdata("teapot.ron");
@@ -164,19 +157,7 @@ fn formats(dir: &Path) -> Vec<Format> {
             ext: "bvh",
             binary: true,
             samples: vec![bvh],
-            commands: vec![vec![
-                "render",
-                teapot,
-                "--bvh",
-                "{}",
-                "--width",
-                "16",
-                "--height",
-                "16",
-                "-q",
-                "-o",
-                "{out}.png",
-            ]],
+            commands: vec![[&["render", teapot, "--bvh", "{}"][..], &TINY_RENDER].concat()],
         },
     ]
 }

@@ -133,15 +133,21 @@ fn frame(z: DVec3, x: DVec3) -> (DVec3, DVec3, DVec3) {
     (x, z.cross(x), z)
 }
 
-#[test]
-fn plane_face_matches_the_definition() {
+/// A plane through (1, 2, 3) with normal (1, 1, 1) and x along (1, −1, 0): its origin,
+/// axis, reference direction and its point at parameters (u, v) by ISO 10303-42.
+fn tilted_plane() -> (DVec3, DVec3, DVec3, impl Fn(f64, f64) -> DVec3) {
     let (o, zd, xd) = (
         DVec3::new(1.0, 2.0, 3.0),
         DVec3::ONE,
         DVec3::new(1.0, -1.0, 0.0),
     );
     let (x, y, _) = frame(zd, xd);
-    let at = |u: f64, v: f64| o + u * x + v * y;
+    (o, zd, xd, move |u: f64, v: f64| o + u * x + v * y)
+}
+
+#[test]
+fn plane_face_matches_the_definition() {
+    let (o, zd, xd, at) = tilted_plane();
     let mut w = StepWriter::default();
     let ax = w.axis(o, zd, xd);
     let plane = w.add(format!("PLANE('',#{ax})"));
@@ -164,13 +170,7 @@ fn plane_face_matches_the_definition() {
 /// inside by up to the chord tolerance).
 #[test]
 fn a_circle_on_a_plane_becomes_an_exact_rational_loop() {
-    let (o, zd, xd) = (
-        DVec3::new(1.0, 2.0, 3.0),
-        DVec3::ONE,
-        DVec3::new(1.0, -1.0, 0.0),
-    );
-    let (x, y, _) = frame(zd, xd);
-    let at = |u: f64, v: f64| o + u * x + v * y;
+    let (o, zd, xd, at) = tilted_plane();
     let (c, r) = (DVec2::new(0.5, 0.25), 0.75);
     let mut w = StepWriter::default();
     let ax = w.axis(o, zd, xd);
