@@ -6,12 +6,14 @@
 //! (144 over any surface, 142 curves on surfaces).
 //!
 //! Drawn are the visible entities that are not physically part of others (§2.3.1 status):
-//! trimmed surfaces (144) and bare surfaces (128, 108, 118, 120, 122). What is not read
+//! trimmed surfaces (144), bounded surfaces (143) and bare surfaces (128, 114, 108, 118,
+//! 120, 122, and the closed analytic 196, 198). What is not read
 //! is counted by type in [`Report`]; a surface that cannot be converted is named by its
 //! directory sequence number; neither is dropped silently.
 
 pub mod curves;
 pub mod directory;
+pub mod elementary;
 pub mod entities;
 pub mod records;
 pub mod surfaces;
@@ -292,7 +294,7 @@ pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
         .entities
         .iter()
         .filter_map(|e| match e {
-            Entity::Trimmed { surface, .. } => Some(*surface),
+            Entity::Trimmed { surface, .. } | Entity::Bounded { surface, .. } => Some(*surface),
             _ => None,
         })
         .collect();
@@ -303,11 +305,14 @@ pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
         }
         let converted = match entity {
             Entity::Trimmed { .. } => trimmed::trimmed(&model, entry.sequence, &mut report),
+            Entity::Bounded { .. } => trimmed::bounded(&model, entry.sequence, &mut report),
             Entity::BSplineSurface(_)
+            | Entity::SplineSurface(_)
+            | Entity::Elementary { .. }
             | Entity::Plane { .. }
             | Entity::Ruled { .. }
             | Entity::Revolution { .. }
-            | Entity::Tabulated { .. } => trimmed::untrimmed(&model, entry.sequence),
+            | Entity::Tabulated { .. } => trimmed::untrimmed(&model, entry.sequence, &mut report),
             Entity::Transform(_) | Entity::Colour(_) => continue,
             _ => {
                 *report.ignored.entry(entry.entity_type).or_default() += 1;
