@@ -1009,3 +1009,192 @@ fn hyperbolic_conic_arc_in_general_position() {
         assert!(cp * l.x + sp * l.y > 0.0);
     }
 }
+
+#[test]
+fn manifold_solid_b_rep_faces_with_edge_lists_and_loops() {
+    let n = net();
+    let (c, r) = (DVec3::new(0.0, 0.0, 5.0), 1.5);
+    // 0: 128; 1–3: 110 model-space curves (unused: parameter curves are given);
+    // 4–6: 110 parameter curves, the third written backwards; 7: 504; 8: 508 (the third
+    // edge OF 0); 9: 510 on the 128; 10: 116; 11: 196; 12: 510 on the sphere, no loops;
+    // 13: 514; 14: 186 (colour 3, translated by 15: 124).
+    let uv = [(0.1, 0.1), (0.9, 0.1), (0.9, 0.9)];
+    let model = |(u, v): (f64, f64)| net_point(&n, u, v);
+    let mut ents = vec![ent(128, &b128(&n, [0.0, 1.0, 0.0, 1.0]))];
+    for k in 0..3 {
+        let (a, b) = (model(uv[k]), model(uv[(k + 1) % 3]));
+        ents.push(ent(110, &[a.x, a.y, a.z, b.x, b.y, b.z]));
+    }
+    for k in 0..3 {
+        let (a, b) = if k == 2 {
+            (uv[0], uv[2])
+        } else {
+            (uv[k], uv[k + 1])
+        };
+        ents.push(ent(110, &[a.0, a.1, 0.0, b.0, b.1, 0.0]));
+    }
+    let mut edges = vec![3.0];
+    for k in 0..3 {
+        edges.extend([de(1 + k), 0.0, 0.0, 0.0, 0.0]);
+    }
+    ents.push(ent(504, &edges));
+    let mut lp = vec![3.0];
+    for k in 0..3 {
+        let of = if k == 2 { 0.0 } else { 1.0 };
+        lp.extend([0.0, de(7), (k + 1) as f64, of, 1.0, 0.0, de(4 + k)]);
+    }
+    ents.push(ent(508, &lp));
+    ents.push(ent(510, &[de(0), 1.0, 1.0, de(8)]));
+    ents.push(vector(116, c));
+    let mut sphere = ent(196, &[de(10), r]);
+    sphere.subordinate = 0; // marked independent: still drawn only as the face
+    ents.push(sphere);
+    let mut red = ent(510, &[de(11), 0.0, 0.0]);
+    red.colour = 2;
+    ents.push(red);
+    ents.push(ent(514, &[2.0, de(9), 1.0, de(12), 1.0]));
+    let mut solid = ent(186, &[de(13), 1.0, 0.0]);
+    solid.subordinate = 0;
+    solid.colour = 3;
+    solid.transform = 31;
+    ents.push(solid);
+    let shift = DVec3::new(1.0, 2.0, -3.0);
+    ents.push(ent(
+        124,
+        &[
+            1.0, 0.0, 0.0, shift.x, 0.0, 1.0, 0.0, shift.y, 0.0, 0.0, 1.0, shift.z,
+        ],
+    ));
+    let read = read(&ents);
+    assert!(read.report.failed.is_empty(), "{:?}", read.report.failed);
+    assert!(read.report.ignored.is_empty(), "{:?}", read.report.ignored);
+    assert_eq!(read.surfaces.len(), 2);
+    let (patch, ball) = (&read.surfaces[0], &read.surfaces[1]);
+    assert_eq!(patch.colour, Some(DVec3::Y));
+    assert_eq!(ball.colour, Some(DVec3::X));
+    let SurfaceGeometry::Nurbs(s) = &patch.surface.geometry else {
+        panic!()
+    };
+    for (u, v) in grid() {
+        close(s.eval(u, v), net_point(&n, u, v) + shift, 8.0, "186 face");
+    }
+    let [outer]: &[TrimLoop; 1] = patch.surface.trims.as_slice().try_into().unwrap();
+    assert!(!outer.hole);
+    for (k, seg) in outer.segments.iter().enumerate() {
+        let (a, b) = (DVec2::from(uv[k]), DVec2::from(uv[(k + 1) % 3]));
+        assert!((trim_point(&seg.curve, seg.t0) - a).length() < REL, "{k}");
+        assert!((trim_point(&seg.curve, seg.t1) - b).length() < REL, "{k}");
+    }
+    let SurfaceGeometry::Nurbs(b) = &ball.surface.geometry else {
+        panic!()
+    };
+    assert!(ball.surface.trims.is_empty());
+    for (u, v) in grid() {
+        let (u, v) = b.domain().to_parent(u, v);
+        let d = (b.eval(u, v) - c - shift).length();
+        assert!((d - r).abs() < 1e-12 * 8.0, "{d}");
+    }
+}
+
+#[test]
+fn subfigure_instances_become_transformed_copies() {
+    let (c, r) = (DVec3::new(0.5, -0.5, 1.0), 0.75);
+    // 0: 116; 1: 123; 2: 196 sphere; 3: 198 torus; 4: 308 {torus}; 5: 408 of 4 at
+    // (5, 0, 0); 6: 308 {sphere, 5}; 7: 408 of 6 at (1, 2, 3) scale 2; 8: 408 of 6
+    // at the origin.
+    let mut member = ent(196, &[de(0), r]);
+    member.subordinate = 0; // a member marked independent is still drawn only per instance
+    let mut outer = ent(408, &[de(6), 1.0, 2.0, 3.0, 2.0]);
+    outer.subordinate = 0;
+    let mut plain = ent(408, &[de(6)]);
+    plain.subordinate = 0;
+    let read = read(&[
+        vector(116, c),
+        vector(123, DVec3::Z),
+        member,
+        ent(198, &[de(0), de(1), 2.0, 0.5]),
+        ent(308, &[0.0, 0.0, 1.0, de(3)]),
+        ent(408, &[de(4), 5.0, 0.0, 0.0, 1.0]),
+        ent(308, &[1.0, 0.0, 2.0, de(2), de(5)]),
+        outer,
+        plain,
+    ]);
+    assert!(read.report.failed.is_empty(), "{:?}", read.report.failed);
+    assert_eq!(read.surfaces.len(), 4);
+    let place = |scale: f64, shift: DVec3, p: DVec3| shift + p * scale;
+    let t = DVec3::new(1.0, 2.0, 3.0);
+    let want: [(DVec3, f64, bool); 4] = [
+        (place(2.0, t, c), 2.0 * r, true),
+        (place(2.0, t, c + DVec3::X * 5.0), 2.0, false),
+        (c, r, true),
+        (c + DVec3::X * 5.0, 1.0, false),
+    ];
+    for (k, (drawn, (centre, scale, is_sphere))) in read.surfaces.iter().zip(want).enumerate() {
+        let SurfaceGeometry::Nurbs(s) = &drawn.surface.geometry else {
+            panic!()
+        };
+        for (u, v) in grid() {
+            let (u, v) = s.domain().to_parent(u, v);
+            let l = s.eval(u, v) - centre;
+            let residual = if is_sphere {
+                l.length() - scale
+            } else {
+                (l.truncate().length() - 2.0 * scale).hypot(l.z) - 0.5 * scale
+            };
+            assert!(residual.abs() < 1e-12 * 16.0, "copy {k}: {residual:e}");
+        }
+    }
+}
+
+#[test]
+fn subfigure_cycles_and_blow_ups_are_refused_by_name() {
+    // 0: 308 holding 1 twice; 1: 408 of 0 (a cycle); 2: 408 of 0, drawn.
+    let mut top = ent(408, &[de(0)]);
+    top.subordinate = 0;
+    let cyclic = read(&[
+        ent(308, &[0.0, 0.0, 2.0, de(1), de(1)]),
+        ent(408, &[de(0)]),
+        top,
+    ]);
+    assert!(cyclic.surfaces.is_empty());
+    assert!(
+        cyclic
+            .report
+            .failed
+            .iter()
+            .all(|f| f.ends_with("the definition D 1 contains an instance of itself")),
+        "{:?}",
+        cyclic.report.failed
+    );
+    // Ten definitions each instancing the next four times: 4^10 copies, cut off.
+    let mut ents = Vec::new();
+    for k in 0..10 {
+        ents.push(ent(
+            308,
+            &[
+                0.0,
+                0.0,
+                4.0,
+                de(2 * k + 1),
+                de(2 * k + 1),
+                de(2 * k + 1),
+                de(2 * k + 1),
+            ],
+        ));
+        ents.push(ent(408, &[de(2 * k + 2)]));
+    }
+    ents.push(ent(308, &[0.0, 0.0, 0.0]));
+    let mut top = ent(408, &[de(0)]);
+    top.subordinate = 0;
+    ents.push(top);
+    let blown = read(&ents);
+    assert!(
+        blown
+            .report
+            .failed
+            .iter()
+            .any(|f| f.contains("more than 65536 entities drawn through instances")),
+        "{:?}",
+        blown.report.failed.len()
+    );
+}

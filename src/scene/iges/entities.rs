@@ -178,6 +178,18 @@ pub struct BoundaryCurve {
     pub parameter: Vec<usize>,
 }
 
+/// One entry of a 508 loop: an edge of a 504 edge list, or a vertex (then empty).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoopEdge {
+    /// The 504 and the 1-based index of the edge in it (0, 0 for a vertex entry).
+    pub list: usize,
+    pub index: usize,
+    /// OF 0: the edge runs against its curve's direction in the loop.
+    pub reversed: bool,
+    /// Its parameter-space curves on the face's surface.
+    pub parameter: Vec<usize>,
+}
+
 /// The supported entities. Pointers are directory sequence numbers (0 for none).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Entity {
@@ -260,6 +272,30 @@ pub enum Entity {
         surface: usize,
         boundaries: Vec<usize>,
     },
+    /// 186: manifold solid B-rep object: its outer shell and void shells (514s).
+    Brep { shells: Vec<usize> },
+    /// 308: subfigure definition: its member entities.
+    Subfigure(Vec<usize>),
+    /// 408: singular subfigure instance of the 308 `definition`, translated and scaled.
+    Instance {
+        definition: usize,
+        translation: DVec3,
+        scale: f64,
+    },
+    /// 504: edge list: the model-space curve of each edge (its vertices are not needed:
+    /// the curves run between them).
+    Edges(Vec<usize>),
+    /// 508: loop of edges.
+    Loop(Vec<LoopEdge>),
+    /// 510: face of `surface` bounded by its 508 `loops`; `outer_first`: OF 1, the first
+    /// loop is the outer one.
+    Face {
+        surface: usize,
+        outer_first: bool,
+        loops: Vec<usize>,
+    },
+    /// 514: shell: its 510 faces.
+    Shell(Vec<usize>),
     /// 142: curve on a parametric surface.
     CurveOnSurface {
         surface: usize,
@@ -302,12 +338,19 @@ pub fn is_supported(entity_type: i32) -> bool {
             | 142
             | 143
             | 144
+            | 186
             | 190
             | 192
             | 194
             | 196
             | 198
+            | 308
             | 314
+            | 408
+            | 504
+            | 508
+            | 510
+            | 514
     )
 }
 
@@ -577,6 +620,81 @@ pub fn read(p: &Params<'_>) -> Result<Entity, ParseError> {
             axis: p.pointer(2)?,
             reference: if form == 1 { p.pointer(5)? } else { 0 },
         },
+        186 => {
+            // SHELL, SOF, N, then N × (VOID, VOF); orientation flags do not matter to
+            // the even–odd trims of each face.
+            let n = p.count(3, MAX_COUNT)?;
+            p.need(3 + 2 * n)?;
+            let mut shells = vec![p.pointer(1)?];
+            for k in 0..n {
+                shells.push(p.pointer(4 + 2 * k)?);
+            }
+            Entity::Brep { shells }
+        }
+        308 => {
+            // DEPTH, NAME, N, then N pointers.
+            let n = p.count(3, MAX_COUNT)?;
+            p.need(3 + n)?;
+            Entity::Subfigure((4..4 + n).map(|i| p.pointer(i)).collect::<Result<_, _>>()?)
+        }
+        408 => Entity::Instance {
+            definition: p.pointer(1)?,
+            translation: DVec3::new(p.real_or(2, 0.0)?, p.real_or(3, 0.0)?, p.real_or(4, 0.0)?),
+            scale: p.real_or(5, 1.0)?,
+        },
+        504 => {
+            // N, then N × (CURV, SVP, SV, TVP, TV).
+            let n = p.count(1, MAX_COUNT)?;
+            p.need(1 + 5 * n)?;
+            Entity::Edges(
+                (0..n)
+                    .map(|k| p.pointer(2 + 5 * k))
+                    .collect::<Result<_, _>>()?,
+            )
+        }
+        508 => {
+            // N, then per entry TYPE, EDGE, NDX, OF, K and K × (ISOP, CURV).
+            let n = p.count(1, MAX_COUNT)?;
+            let mut edges = Vec::with_capacity(n.min(1024));
+            let mut at = 2;
+            for _ in 0..n {
+                let k = p.count(at + 4, MAX_COUNT)?;
+                p.need(at + 4 + 2 * k)?;
+                let vertex = p.int(at)? == 1;
+                edges.push(LoopEdge {
+                    list: if vertex { 0 } else { p.pointer(at + 1)? },
+                    index: if vertex {
+                        0
+                    } else {
+                        p.count(at + 2, MAX_COUNT)?
+                    },
+                    reversed: p.int(at + 3)? == 0,
+                    parameter: (0..k)
+                        .map(|j| p.pointer(at + 6 + 2 * j))
+                        .collect::<Result<_, _>>()?,
+                });
+                at += 5 + 2 * k;
+            }
+            Entity::Loop(edges)
+        }
+        510 => {
+            let n = p.count(2, MAX_COUNT)?;
+            p.need(3 + n)?;
+            Entity::Face {
+                surface: p.pointer(1)?,
+                outer_first: p.int(3)? == 1,
+                loops: (4..4 + n).map(|i| p.pointer(i)).collect::<Result<_, _>>()?,
+            }
+        }
+        514 => {
+            let n = p.count(1, MAX_COUNT)?;
+            p.need(1 + 2 * n)?;
+            Entity::Shell(
+                (0..n)
+                    .map(|k| p.pointer(2 + 2 * k))
+                    .collect::<Result<_, _>>()?,
+            )
+        }
         314 => Entity::Colour(DVec3::new(p.real(1)?, p.real(2)?, p.real(3)?)),
         _ => Entity::Unsupported,
     })

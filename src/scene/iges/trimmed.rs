@@ -112,6 +112,57 @@ pub fn bounded(model: &Model, pointer: usize, report: &mut Report) -> Result<Sur
     Ok(s)
 }
 
+/// A 510 face of a 186 solid: its surface cut by its 508 loops, whose edges are the
+/// model-space curves of 504 edge lists with their parameter-space curves (used where
+/// given). Without OF 1 no loop is outer, and the domain's boundary is.
+pub fn face(model: &Model, pointer: usize, report: &mut Report) -> Result<Surface, String> {
+    let Entity::Face {
+        surface,
+        outer_first,
+        loops,
+    } = model.get(pointer)?.1
+    else {
+        return Err(format!("D {pointer} is not a face (510)"));
+    };
+    let mut boundaries = Vec::new();
+    for (k, &l) in loops.iter().enumerate() {
+        let Entity::Loop(entries) = model.get(l)?.1 else {
+            return Err(format!("the loop D {l} is not a loop (508)"));
+        };
+        let mut edges = Vec::new();
+        // Vertex entries (list 0) bound nothing.
+        for e in entries.iter().filter(|e| e.list != 0) {
+            let Entity::Edges(curves) = model.get(e.list)?.1 else {
+                return Err(format!(
+                    "the edge list D {} is not an edge list (504)",
+                    e.list
+                ));
+            };
+            let curve = *e
+                .index
+                .checked_sub(1)
+                .and_then(|i| curves.get(i))
+                .ok_or_else(|| {
+                    format!(
+                        "edge {} of the edge list D {} does not exist",
+                        e.index, e.list
+                    )
+                })?;
+            edges.push(Edge {
+                model: curve,
+                parameter: e.parameter.clone(),
+                reversed: e.reversed,
+            });
+        }
+        boundaries.push(Boundary {
+            hole: !(*outer_first && k == 0),
+            model_preferred: false,
+            edges,
+        });
+    }
+    with_loops(model, *surface, &boundaries, report, false)
+}
+
 /// A 142 as a boundary.
 fn curve_on_surface(model: &Model, pointer: usize, hole: bool) -> Result<Boundary, String> {
     let Entity::CurveOnSurface {
