@@ -25,6 +25,11 @@ use super::Model;
 use super::entities::{Elementary, Entity};
 use crate::geom::nurbs::analytic::{self, Frame, MappedSurface, Span};
 
+/// A reference direction whose part orthogonal to the axis is below this fraction of its
+/// length is taken as parallel: an X built from it would carry the writer's rounding
+/// magnified a billion times, so form 1's u origin would be noise.
+const PARALLEL: f64 = 1e-9;
+
 /// A 190–198 surface in its definition space, and the transform into model space.
 pub struct Placed {
     pub shape: Elementary,
@@ -38,26 +43,22 @@ fn err(e: impl std::fmt::Display) -> String {
     e.to_string()
 }
 
-/// The location of a 116 (its own transform applied).
-fn point(model: &Model, pointer: usize) -> Result<DVec3, String> {
+/// The location of a 116 (`point`: its transform applied) or the vector of a 123 (the
+/// rotation of its transform only, §4.20).
+fn placement(model: &Model, pointer: usize, point: bool) -> Result<DVec3, String> {
     let (entry, entity) = model.get(pointer)?;
-    match entity {
-        Entity::Point(p) => Ok(model.transform(entry.transform)?.transform_point3(*p)),
+    let m = model.transform(entry.transform)?;
+    match (entity, point) {
+        (Entity::Point(p), true) => Ok(m.transform_point3(*p)),
+        (Entity::Direction(d), false) => Ok(m.transform_vector3(*d)),
         _ => Err(format!(
-            "the location D {pointer} is entity {}, not a point (116)",
-            entry.entity_type
-        )),
-    }
-}
-
-/// The vector of a 123 (the rotation of its own transform applied, §4.20).
-fn direction(model: &Model, pointer: usize) -> Result<DVec3, String> {
-    let (entry, entity) = model.get(pointer)?;
-    match entity {
-        Entity::Direction(d) => Ok(model.transform(entry.transform)?.transform_vector3(*d)),
-        _ => Err(format!(
-            "the direction D {pointer} is entity {}, not a direction (123)",
-            entry.entity_type
+            "D {pointer} is entity {}, not a {}",
+            entry.entity_type,
+            if point {
+                "point (116)"
+            } else {
+                "direction (123)"
+            }
         )),
     }
 }
@@ -74,19 +75,19 @@ pub fn placed(model: &Model, pointer: usize) -> Result<Option<Placed>, String> {
     else {
         return Ok(None);
     };
-    let origin = point(model, *location)?;
+    let origin = placement(model, *location, true)?;
     // Form 0 of the sphere has no axis: any will do.
     let z = if *axis == 0 {
         DVec3::Z
     } else {
-        direction(model, *axis)?
+        placement(model, *axis, false)?
     };
     let x = if *reference == 0 {
         None
     } else {
-        let r = direction(model, *reference)?;
+        let r = placement(model, *reference, false)?;
         let zn = z.normalize_or_zero();
-        if (r - zn * r.dot(zn)).length() <= 1e-9 * r.length() {
+        if (r - zn * r.dot(zn)).length() <= PARALLEL * r.length() {
             return Err(format!(
                 "the reference direction D {reference} is parallel to the axis"
             ));
