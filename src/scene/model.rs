@@ -129,6 +129,18 @@ impl Surface {
         }
     }
 
+    /// The same surface seen from its other side: u and v exchanged in the geometry, the
+    /// loops and their parameter maps, so the normal `S_u × S_v` turns around and nothing
+    /// else moves (a STEP face whose `same_sense` is false, ISO 10303-42 §5.4.23).
+    pub fn flip_sides(&mut self) {
+        self.geometry = match &self.geometry {
+            SurfaceGeometry::Bezier(p) => SurfaceGeometry::Bezier(p.transposed()),
+            SurfaceGeometry::Nurbs(n) => SurfaceGeometry::Nurbs(n.transposed()),
+        };
+        self.trims = self.trims.iter().map(TrimLoop::transposed).collect();
+        self.trim_space.swap(0, 1);
+    }
+
     /// The region the trim loops keep, `None` without loops; an error for loops that cannot
     /// be converted (the readers check this at load, [`crate::scene::check_trims`]).
     pub fn trim_region(&self) -> Result<Option<TrimRegion>, TrimError> {

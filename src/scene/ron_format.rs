@@ -342,11 +342,15 @@ fn build_scene(path: &Path, at: &RonLocator, file: SceneFile) -> Result<Scene, L
             }
         };
         let mut geometry = match &o.geometry {
-            GeometryDef::File(f) => super::load::load_geometry(&base.join(f))
-                .map_err(|e| referenced(at, index, f, e))?,
+            GeometryDef::File(f) => {
+                super::load::load_geometry(&base.join(file_name(at, index, f)?))
+                    .map_err(|e| referenced(at, index, f, e))?
+            }
             GeometryDef::Subdivision(inner) => match inner.as_ref() {
-                GeometryDef::File(f) => super::load::load_subdivision(&base.join(f))
-                    .map_err(|e| referenced(at, index, f, e))?,
+                GeometryDef::File(f) => {
+                    super::load::load_subdivision(&base.join(file_name(at, index, f)?))
+                        .map_err(|e| referenced(at, index, f, e))?
+                }
                 _ => {
                     return Err(at
                         .at_object(
@@ -419,6 +423,20 @@ fn build_scene(path: &Path, at: &RonLocator, file: SceneFile) -> Result<Scene, L
         materials,
         objects,
     })
+}
+
+/// The file name of a `File(...)`, refused when empty (joined to the scene's directory it
+/// would name the directory itself).
+fn file_name<'a>(at: &RonLocator, index: usize, f: &'a str) -> Result<&'a str, LoadError> {
+    if f.trim().is_empty() {
+        return Err(at
+            .at_object(
+                index,
+                format!("object {index}: expected a geometry file name in File(\"...\"), found an empty string"),
+            )
+            .into());
+    }
+    Ok(f)
 }
 
 /// The camera's animation, checked: an orbit has at least one frame and a finite angle;
