@@ -21,6 +21,7 @@ use crate::kernel::triangle::{
     self, PACK_WIDTH, PackShear, RayShear, TriangleHit, TrianglePack, intersect_pack,
 };
 use crate::kernel::{KernelStats, PatchHit};
+use crate::progress::ProgressBar;
 use crate::scene::{Geometry, Scene};
 
 /// Which intersection path answers queries.
@@ -241,13 +242,25 @@ pub struct SceneGeometry {
 impl SceneGeometry {
     /// Prepares the patches and builds the BVH.
     pub fn build(scene: &Scene) -> SceneGeometry {
+        Self::build_with(scene, &ProgressBar::hidden())
+    }
+
+    /// [`build`](Self::build), advancing `progress` to twice the primitive count: one step
+    /// per primitive bounded (a trimmed patch's box is the costly part), one per primitive
+    /// placed in a BVH leaf.
+    pub fn build_with(scene: &Scene, progress: &ProgressBar) -> SceneGeometry {
         let patches = collect_patches(scene);
         let triangles = collect_triangles(scene);
+        let primitives = patches.originals.len() + triangles.corners.len();
+        progress.set_length(2 * primitives as u64);
         let boxes: Vec<Aabb> = patches
             .originals
             .iter()
             .zip(&patches.trims)
-            .map(|(p, trim)| surviving_box(p, trim.as_deref()).to_f32_outward())
+            .map(|(p, trim)| {
+                progress.inc(1);
+                surviving_box(p, trim.as_deref()).to_f32_outward()
+            })
             .chain(
                 triangles
                     .corners
@@ -255,7 +268,8 @@ impl SceneGeometry {
                     .map(|c| c.iter().copied().collect()),
             )
             .collect();
-        let bvh = Bvh::build_packed(&boxes, patches.originals.len());
+        progress.inc(triangles.corners.len() as u64);
+        let bvh = Bvh::build_packed_with(&boxes, patches.originals.len(), progress);
         let accel = Accel::bvh(bvh, patches.originals.len(), &triangles);
         Self::with_accel(patches, triangles, accel)
     }

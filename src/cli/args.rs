@@ -159,6 +159,9 @@ pub struct InfoArgs {
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
+    /// No progress bars.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 #[derive(Debug, Args)]
@@ -171,6 +174,9 @@ pub struct ImportArgs {
     /// (non-rational patches) or .obj (free-form Bézier patches).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// No progress bars.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 #[derive(Debug, Args)]
@@ -185,6 +191,9 @@ pub struct ConvertArgs {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+    /// No progress bars.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 /// Intersection kernel.
@@ -450,6 +459,9 @@ pub struct TraceArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// No progress bars.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 #[derive(Debug, Args)]
@@ -461,6 +473,9 @@ pub struct BvhArgs {
     /// Output BVH file.
     #[arg(short, long)]
     pub output: PathBuf,
+    /// No progress bars.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 #[derive(Debug, Args)]
