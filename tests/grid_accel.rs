@@ -29,6 +29,7 @@ fn teapots(count: usize, seed: u64) -> Scene {
         lights: 1,
         width: 64,
         height: 64,
+        flatten: false,
     };
     let path = dir.path().join("scene.ron");
     std::fs::write(&path, teapots_scene(&spec)).unwrap();
