@@ -81,7 +81,12 @@ impl Placement {
         let proto = prototype.bounds();
         let scale = proto.min.abs().max(proto.max.abs()).max_element();
         let leave_margin = LEAVE_MARGIN_FACTOR * inf_norm(&linear) * ulp_of(scale);
-        let bounds = grown(to_daabb(&proto).transformed(&to_world), leave_margin);
+        // The placed hull of the control points holds the placed surface (the convex hull
+        // property), and is much tighter than the placed corners of the prototype's box
+        // for a rotated instance. The margin covers the rounding of the points to `f32`
+        // (half an ulp of the prototype's scale, placed).
+        let hull = DAabb::of_mapped_points(prototype.hull_points(), &to_world);
+        let bounds = grown(hull, leave_margin);
         Some(Placement {
             prototype: index,
             object,

@@ -422,6 +422,16 @@ impl SceneGeometry {
                 .sum::<usize>()
     }
 
+    /// Points whose convex hull holds the surface of the scene's own patches and
+    /// triangles: control points and corners.
+    pub(super) fn hull_points(&self) -> impl Iterator<Item = DVec3> + '_ {
+        let corners = self.triangles.corners.iter().flatten();
+        self.originals
+            .iter()
+            .flat_map(|p| p.euclidean_points())
+            .chain(corners.map(|c| c.as_dvec3()))
+    }
+
     pub fn instance_count(&self) -> usize {
         self.instances.len()
     }
@@ -620,7 +630,8 @@ impl SceneGeometry {
                             tmax: *tmax,
                             ..*ray
                         };
-                        if let Some(h) = self.instance_hit(k, &r, precision, &mut nested) {
+                        let (prototype, r, local) = self.enter_instance(k, &r, precision);
+                        if let Some(h) = prototype.intersect(&r, &local, &mut nested) {
                             *tmax = tmax.min(h.t as f32);
                             best = Some(Candidate::Instance(k, Box::new(h)));
                         }
@@ -658,32 +669,18 @@ impl SceneGeometry {
         best
     }
 
-    /// The nearest hit through instance `k` of `ray`, in object space.
-    fn instance_hit(
+    /// What instance `k` is queried with for `ray`: its shared geometry, the ray in
+    /// object space and the precision for it.
+    fn enter_instance(
         &self,
         k: u32,
         ray: &Ray,
         precision: &Precision,
-        stats: &mut QueryStats,
-    ) -> Option<SceneHit> {
+    ) -> (&SceneGeometry, Ray, Precision) {
         let placement = &self.instances[k as usize];
         let prototype = &self.prototypes[placement.prototype as usize];
         let local = placement.precision_in_object(precision, prototype.prepared.len() as u32);
-        prototype.intersect(&placement.ray_to_object(ray), &local, stats)
-    }
-
-    /// Whether instance `k` blocks `ray`.
-    fn instance_blocks(
-        &self,
-        k: u32,
-        ray: &Ray,
-        precision: &Precision,
-        stats: &mut QueryStats,
-    ) -> bool {
-        let placement = &self.instances[k as usize];
-        let prototype = &self.prototypes[placement.prototype as usize];
-        let local = placement.precision_in_object(precision, prototype.prepared.len() as u32);
-        prototype.occluded(&placement.ray_to_object(ray), &local, stats)
+        (prototype, placement.ray_to_object(ray), local)
     }
 
     /// Whether anything in the BVH blocks `ray`.
@@ -707,7 +704,9 @@ impl SceneGeometry {
             surface_tests += range.len() as u64;
             hit = bvh.prim_indices()[range.clone()].iter().any(|&prim| {
                 if prim >= first_instance {
-                    self.instance_blocks(prim - first_instance, ray, precision, &mut nested)
+                    let (prototype, r, local) =
+                        self.enter_instance(prim - first_instance, ray, precision);
+                    prototype.occluded(&r, &local, &mut nested)
                 } else {
                     prim < patches && self.patch_occluded(prim, &mut patch_ray, precision, kernel)
                 }

@@ -200,19 +200,29 @@ impl DAabb {
         if self.is_empty() {
             return DAabb::EMPTY;
         }
+        DAabb::of_mapped_points(
+            (0..8).map(|k| {
+                let pick = |bit: usize, lo: f64, hi: f64| if k & bit == 0 { lo } else { hi };
+                DVec3::new(
+                    pick(1, self.min.x, self.max.x),
+                    pick(2, self.min.y, self.max.y),
+                    pick(4, self.min.z, self.max.z),
+                )
+            }),
+            m,
+        )
+    }
+
+    /// The box of `points` mapped by `m` in `f64`, each grown by the bound on the map's
+    /// rounding of [`DAabb::transformed`]: it holds their exact images.
+    pub fn of_mapped_points(points: impl IntoIterator<Item = DVec3>, m: &glam::DAffine3) -> DAabb {
         let abs = glam::DMat3::from_cols(
             m.matrix3.x_axis.abs(),
             m.matrix3.y_axis.abs(),
             m.matrix3.z_axis.abs(),
         );
         let mut out = DAabb::EMPTY;
-        for k in 0..8 {
-            let pick = |bit: usize, lo: f64, hi: f64| if k & bit == 0 { lo } else { hi };
-            let c = DVec3::new(
-                pick(1, self.min.x, self.max.x),
-                pick(2, self.min.y, self.max.y),
-                pick(4, self.min.z, self.max.z),
-            );
+        for c in points {
             let p = m.transform_point3(c);
             let err = (abs * c.abs() + m.translation.abs()) * AFFINE_ROUNDING;
             out.grow(p - err);
