@@ -246,3 +246,58 @@ fn the_scene_samples_field_is_the_default_spp() {
     assert_eq!(decode(&s), decode(&four));
     assert!(decode(&s) != decode(&render_ok(&d.join("1.png"), &["--spp", "1"])));
 }
+
+/// Rows and columns of `png` that hold a pixel other than the top-left (background) one.
+fn covered_extent(png: &Path) -> (usize, usize) {
+    let img = image::open(png).unwrap().to_rgb8();
+    let bg = *img.get_pixel(0, 0);
+    let (mut rows, mut cols) = (
+        vec![false; img.height() as usize],
+        vec![false; img.width() as usize],
+    );
+    for (x, y, p) in img.enumerate_pixels() {
+        if *p != bg {
+            rows[y as usize] = true;
+            cols[x as usize] = true;
+        }
+    }
+    let count = |v: &[bool]| v.iter().filter(|&&b| b).count();
+    (count(&rows), count(&cols))
+}
+
+/// A unit cube seen from the y-up and the z-up framing gives the same image (it is
+/// symmetric under the quarter turn between them), so the framing is tested on a column
+/// three times as long along glTF's up axis, y: upright it is much taller than wide in the
+/// image; lying along the view of a z-up camera it is not.
+#[test]
+fn gltf_is_framed_y_up_by_default_and_up_is_refused_for_scenes() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mut gltf: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(testdata("quad_mesh.gltf")).unwrap())
+            .unwrap();
+    gltf["nodes"][0] = serde_json::json!({"name": "column", "mesh": 0, "scale": [1, 3, 1]});
+    let column = d.join("column.gltf");
+    std::fs::write(&column, gltf.to_string()).unwrap();
+    let img = |name: &str, extra: &[&str]| {
+        let out = d.join(name);
+        let o = render(&column, &out, (48, 48), extra);
+        assert!(o.status.success(), "{}", stderr(&o));
+        out
+    };
+    let decode = |p: &Path| image::open(p).unwrap().to_rgba8().into_raw();
+    let default = img("d.png", &[]);
+    assert!(decode(&default) == decode(&img("y.png", &["--up", "y"])));
+    let (rows, cols) = covered_extent(&default);
+    assert!(rows > 2 * cols, "y up: {rows} rows, {cols} columns");
+    let (rows, cols) = covered_extent(&img("z.png", &["--up", "z"]));
+    assert!(rows < cols + cols / 4, "z up: {rows} rows, {cols} columns");
+    let o = render(
+        &testdata("teapot.ron"),
+        &d.join("t.png"),
+        SIZE,
+        &["--up", "y"],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("bare geometry"), "{}", stderr(&o));
+}

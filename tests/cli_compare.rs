@@ -20,6 +20,9 @@ fn obj_and_gltf_of_the_same_mesh_render_the_same_pixels() {
             "48",
             "--height",
             "48",
+            // glTF is framed y-up by default, OBJ z-up: the same framing for both.
+            "--up",
+            "z",
         ]);
         assert!(o.status.success(), "{name}: {}", stderr(&o));
         // The pixels, not the file: the file records the scene's fingerprint, and the two

@@ -160,7 +160,8 @@ fn effort_aov_counts_every_split_of_the_render() {
     let total_splits = s["rays"]["splits_per_ray"]["mean"].as_f64().unwrap()
         * s["rays"]["total"].as_f64().unwrap();
     use exr::prelude::*;
-    let img = read_first_flat_layer_from_file(dir.path().join("e-effort.exr")).unwrap();
+    // Beside a PNG, the layers are one EXR, <name>-aov.exr.
+    let img = read_first_flat_layer_from_file(dir.path().join("e-aov.exr")).unwrap();
     let channel = &img.layer_data.channel_data.list[0];
     assert_eq!(channel.name.to_string(), "effort");
     let values: Vec<f32> = channel.sample_data.values_as_f32().collect();

@@ -460,7 +460,12 @@ fn continued_lines_report_the_physical_position() {
 #[test]
 fn trims_need_defined_curves() {
     let src = with_line(10, "trim 0 1 1\nend");
-    assert_error(&src, 10, 10, "dangling curv2 index `1`: expected 1 to 0");
+    assert_error(
+        &src,
+        10,
+        10,
+        "dangling curv2 index `1`: no curv2 is defined before this line",
+    );
 }
 
 #[test]

@@ -185,6 +185,22 @@ fn a_missing_referenced_file_names_the_scene_line_that_refers_to_it() {
     assert!(err.contains("missing.bpt: No such file"), "{err}");
 }
 
+/// `File("")` would name the scene's own directory: it is refused at the object as an
+/// empty name, not as "unknown file type" of a directory.
+#[test]
+fn an_empty_geometry_file_name_is_refused_at_the_object() {
+    let d = Dir::new();
+    let scene = d.file(
+        "empty.ron",
+        "Scene(camera: (eye: (0, -5, 0), look_at: (0, 0, 0), up: (0, 0, 1), fov_y: 40, width: 8, height: 8),\n    objects: [\n        (geometry: File(\"\")),\n    ])",
+    );
+    let err = refused(&run(&["info", s(&scene)]));
+    assert!(
+        err.contains("empty.ron:3:10: object 0: expected a geometry file name in File(\"...\"), found an empty string"),
+        "{err}"
+    );
+}
+
 #[test]
 fn ron_value_checks_are_located() {
     let d = Dir::new();

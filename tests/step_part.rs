@@ -7,7 +7,7 @@
 mod common;
 mod step_support;
 
-use common::{run, stderr, stdout};
+use common::{run, stderr, stdout, trace_hits};
 use glam::DVec3;
 use step_support::{FILLET, HOLE, PLATE, bracket};
 
@@ -16,33 +16,9 @@ struct Hit {
 }
 
 fn trace(scene: &std::path::Path, rays: &[(DVec3, DVec3)]) -> Vec<Option<Hit>> {
-    let dir = scene.parent().unwrap();
-    let file = dir.join("rays.txt");
-    let text: String = rays
-        .iter()
-        .map(|(o, d)| format!("{} {} {} {} {} {}\n", o.x, o.y, o.z, d.x, d.y, d.z))
-        .collect();
-    std::fs::write(&file, text).unwrap();
-    let o = run(&[
-        "trace",
-        scene.to_str().unwrap(),
-        "--rays",
-        file.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    stdout(&o)
-        .lines()
-        .skip(1)
-        .map(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            (f[1] == "1").then(|| Hit {
-                point: DVec3::new(
-                    f[7].parse().unwrap(),
-                    f[8].parse().unwrap(),
-                    f[9].parse().unwrap(),
-                ),
-            })
-        })
+    trace_hits(scene, rays)
+        .into_iter()
+        .map(|h| h.map(|(point, _)| Hit { point }))
         .collect()
 }
 
@@ -143,6 +119,100 @@ fn rays_at_the_middle_of_every_face_hit_that_face() {
             "{name}: hit {} expected {want}",
             hit.point
         );
+    }
+}
+
+/// Rays through the hole (the top plane's and the bottom B-spline's inner loops, the wall's
+/// and fillet's seams) must pass: vertical rays on a polar grid inside the wall's radius,
+/// seam angle included, both ways, and slanted rays through the hole's centre that stay
+/// inside the wall and under the fillet (offset at most 0.8 · 0.5 = 0.4 < HOLE at z = 0
+/// and z = 1). Rays just outside the fillet's outer circle must still hit the top plane.
+#[test]
+fn rays_through_the_hole_pass_and_just_outside_it_hit_the_top() {
+    let dir = tempfile::tempdir().unwrap();
+    let part = write_part(dir.path());
+    let (a, f) = (HOLE, FILLET);
+    let mut through = Vec::new();
+    for i in 0..12 {
+        let r = a * (0.02 + 0.96 * i as f64 / 11.0);
+        for j in 0..16 {
+            let t = std::f64::consts::TAU * j as f64 / 16.0;
+            let (x, y) = (r * t.cos(), r * t.sin());
+            through.push((DVec3::new(x, y, 3.0), -DVec3::Z));
+            through.push((DVec3::new(x, y, -2.0), DVec3::Z));
+        }
+    }
+    for j in 0..16 {
+        let t = std::f64::consts::TAU * j as f64 / 16.0;
+        let d = DVec3::new(0.8 * t.cos(), 0.8 * t.sin(), -1.0);
+        let centre = DVec3::new(0.0, 0.0, 0.5);
+        through.push((centre - 3.0 * d, d));
+    }
+    let hits = trace(&part, &through);
+    for ((o, d), hit) in through.iter().zip(&hits) {
+        assert!(
+            hit.is_none(),
+            "ray from {o} along {d} through the hole hit {}",
+            hit.as_ref().unwrap().point
+        );
+    }
+    // Just outside the fillet's outer circle (radius HOLE + FILLET), every 15 degrees.
+    let outside: Vec<(DVec3, DVec3)> = (0..24)
+        .map(|j| {
+            let t = std::f64::consts::TAU * j as f64 / 24.0;
+            let r = (a + f) * 1.01;
+            (DVec3::new(r * t.cos(), r * t.sin(), 3.0), -DVec3::Z)
+        })
+        .collect();
+    for ((o, _), hit) in outside.iter().zip(trace(&part, &outside)) {
+        let hit = hit.unwrap_or_else(|| panic!("ray down at {o} missed the top plane"));
+        assert!(
+            (hit.point.z - 1.0).abs() < 1e-5,
+            "at {o}: hit {}",
+            hit.point
+        );
+    }
+}
+
+/// `same_sense` false turns the face's normal around (ISO 10303-42 §5.4.23) and changes
+/// nothing else: a plane z = 0 with normal +z, a square face with a square hole, read both
+/// ways; the hit points agree, the normals are +z and −z, the hole stays a hole.
+#[test]
+fn same_sense_false_turns_the_normal_and_keeps_the_trims() {
+    let dir = tempfile::tempdir().unwrap();
+    let square = |h: f64| [(-h, -h), (h, -h), (h, h), (-h, h)].map(|(x, y)| DVec3::new(x, y, 0.0));
+    let rays = [
+        (DVec3::new(0.7, 0.2, 2.0), -DVec3::Z),
+        (DVec3::new(-0.3, -0.8, -2.0), DVec3::Z),
+        (DVec3::new(0.1, 0.1, 2.0), -DVec3::Z),
+    ];
+    let mut normals = Vec::new();
+    for same_sense in [true, false] {
+        let mut w = step_support::StepWriter::default();
+        let ax = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
+        let plane = w.add(format!("PLANE('',#{ax})"));
+        let outer = w.polygon_bound(&square(1.0), true);
+        let hole = w.polygon_bound(&square(0.25), false);
+        w.face_with_sense(&[outer, hole], plane, same_sense);
+        let path = dir.path().join(format!("sense_{same_sense}.step"));
+        std::fs::write(&path, w.finish()).unwrap();
+        let hits = trace_hits(&path, &rays);
+        for (k, want) in [DVec3::new(0.7, 0.2, 0.0), DVec3::new(-0.3, -0.8, 0.0)]
+            .iter()
+            .enumerate()
+        {
+            let (point, _) = hits[k].unwrap_or_else(|| panic!("ray {k} missed"));
+            assert!(point.distance(*want) < 1e-6, "{point} vs {want}");
+        }
+        assert!(
+            hits[2].is_none(),
+            "the hole is kept with same_sense {same_sense}"
+        );
+        normals.push(hits[0].unwrap().1);
+    }
+    let want = [DVec3::Z, -DVec3::Z];
+    for (n, w) in normals.iter().zip(want) {
+        assert!(n.normalize().distance(w) < 1e-6, "normal {n}, expected {w}");
     }
 }
 

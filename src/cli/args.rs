@@ -392,24 +392,33 @@ pub struct RenderArgs {
     /// `--tile $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT`; `patchtrace merge` joins them.
     #[arg(long, value_name = "K/N")]
     pub tile: Option<crate::render::window::Tile>,
-    /// Print statistics as JSON on stdout.
+    /// Render this frame of the scene's camera animation (`orbit` or `keyframes`),
+    /// from 0. Without an animation every frame is the still camera.
+    #[arg(long, value_name = "N", conflicts_with = "frames")]
+    pub frame: Option<u32>,
+    /// Render frames A to B inclusive, every STEP-th (Blender's `-s A -e B -j STEP`),
+    /// each to the output name with its last run of `#` replaced by the zero-padded frame
+    /// number (`turn_####.png` → `turn_0007.png`). Frames are deterministic, so ranges can
+    /// be split across processes or machines.
+    #[arg(long, value_name = "A..B[:STEP]")]
+    pub frames: Option<crate::scene::animation::FrameRange>,
+    /// Print statistics as JSON on stdout (one document per frame).
     #[arg(long)]
     pub stats: bool,
-    /// Extra outputs beside the image: `effort` writes <name>-effort.exr (splits per pixel)
-    /// and a colour-mapped <name>-effort.png (Dammertz Fig. 2.9).
-    #[arg(long, value_enum, value_delimiter = ',')]
+    /// Extra layers, comma separated, or `all`: depth (`Z`), position (`P.X`, `P.Y`,
+    /// `P.Z`), normal (`N.X`, …), uv (`UV.U`, `UV.V`), object and patch (`id.object`,
+    /// `id.patch`, u32), effort (de Casteljau splits per pixel, also drawn as
+    /// <name>-effort.png, Dammertz Fig. 2.9). They are channels of the output EXR, or of
+    /// <name>-aov.exr beside a PNG. Geometric layers come from the pixel's centre ray; a
+    /// miss has Z = inf and ids 4294967295.
+    #[arg(long, value_enum, value_delimiter = ',', value_name = "LIST|all")]
     pub aov: Vec<Aov>,
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
 }
 
-/// Arbitrary output variables of `render`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Aov {
-    /// de Casteljau splits of all rays started from each pixel.
-    Effort,
-}
+pub use crate::render::aov::Aov;
 
 #[derive(Debug, Args)]
 pub struct MergeArgs {
@@ -586,9 +595,15 @@ pub struct AccuracyArgs {
     pub quiet: bool,
 }
 
-/// Overrides of the scene camera's image size.
+/// Overrides of the scene camera's image size, and of the up axis bare geometry is framed
+/// with.
 #[derive(Debug, Args, Clone, Copy)]
 pub struct ImageSizeArgs {
+    /// Bare geometry only: the axis that points up in the model, for the default camera
+    /// (default: y for glTF, by its specification; z otherwise). In a RON scene, give the
+    /// object `up: Y` instead.
+    #[arg(long, value_enum)]
+    pub up: Option<crate::scene::model::Axis>,
     /// Override the camera's image width (1 to 32768; a render holds at most 2^26 pixels).
     #[arg(long, value_parser = image_edge())]
     pub width: Option<u32>,
@@ -602,14 +617,22 @@ fn image_edge() -> clap::builder::RangedI64ValueParser<u32> {
 }
 
 impl ImageSizeArgs {
-    /// Applies the overrides to `camera`, refusing an edge beyond
-    /// [`MAX_IMAGE_EDGE`](crate::scene::MAX_IMAGE_EDGE).
-    pub fn apply(&self, camera: &mut crate::scene::Camera) -> anyhow::Result<()> {
+    /// Applies the overrides to the scene read from `path`, refusing an edge beyond
+    /// [`MAX_IMAGE_EDGE`](crate::scene::MAX_IMAGE_EDGE); bare geometry is framed again for
+    /// the new size and `--up`.
+    pub fn apply(
+        &self,
+        path: &std::path::Path,
+        scene: &mut crate::scene::Scene,
+    ) -> anyhow::Result<()> {
+        let camera = &mut scene.camera;
         camera.width = self.width.unwrap_or(camera.width);
         camera.height = self.height.unwrap_or(camera.height);
         camera
             .check_size()
-            .map_err(|e| crate::cli::BadArgument(format!("--width/--height: {e}")).into())
+            .map_err(|e| crate::cli::BadArgument(format!("--width/--height: {e}")))?;
+        crate::scene::load::reframe(path, scene, self.up)?;
+        Ok(())
     }
 }
 

@@ -64,7 +64,7 @@ fn render(scene: &Scene, quiet: bool, label: &str, pool: &rayon::ThreadPool) -> 
 pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     let pool = thread_pool(args.threads)?;
     let mut scene = load_scene_with(&args.scene, args.mesh.load_options())?;
-    args.size.apply(&mut scene.camera)?;
+    args.size.apply(&args.scene, &mut scene)?;
     crate::scene::check_film_pixels(scene.camera.width, scene.camera.height)
         .map_err(crate::cli::BadArgument)?;
     std::fs::create_dir_all(&args.out_dir)

@@ -1,14 +1,16 @@
 //! `patchtrace render SCENE -o OUT.png|OUT.exr`.
 
 use std::io::Write;
+use std::path::Path;
 use std::process::ExitCode;
 use std::time::Instant;
 
 use serde::Serialize;
 
 use crate::cli::args::{Aov, RenderArgs};
-use crate::cli::setup::{precision, prepare, thread_pool};
-use crate::render::film::{ImageFormat, write_effort};
+use crate::cli::setup::{Prepared, precision, prepare, thread_pool};
+use crate::render::aov;
+use crate::render::film::{ImageFormat, sibling, write_effort_png};
 use crate::render::integrator::{Integrator, TraceSettings};
 use crate::render::piece::{PieceInfo, fingerprint, write_exr, write_png};
 use crate::render::plan::EffectPlan;
@@ -16,6 +18,7 @@ use crate::render::renderer::{RenderJob, progress_bar, render};
 use crate::render::sampler::SampleCount;
 use crate::render::stats::{PhaseTimes, RayReport};
 use crate::render::window::Window;
+use crate::scene::animation::frame_path;
 use crate::scene::{LoadError, Scene};
 
 /// How many samples a render took.
@@ -80,14 +83,17 @@ fn geometry_fingerprints(scene: &Scene) -> Vec<(usize, u64)> {
 /// `--height`; everything but object names, which change no pixel) and of the kernel
 /// flags, and every setting that changes pixels. `--bvh`
 /// is left out: a BVH file is the BVH the scene builds, wherever it is stored.
-fn provenance(scene: &Scene, args: &RenderArgs, samples: SampleCount) -> String {
+fn provenance(scene: &Scene, args: &RenderArgs, samples: SampleCount, frame: u32) -> String {
     let kernel = crate::cli::args::KernelArgs {
         bvh: None,
         ..args.kernel.clone()
     };
-    let aov: Vec<String> = args.aov.iter().map(|a| format!("{a:?}")).collect();
+    let aov: Vec<String> = aov::expand(&args.aov)
+        .iter()
+        .map(|a| format!("{a:?}"))
+        .collect();
     format!(
-        "patchtrace {}; scene {:016x}; size {}x{}; spp {samples}; filter {:?}; ulps {}; kernel {:016x}; aov [{}]",
+        "patchtrace {}; scene {:016x}; size {}x{}; frame {frame}; spp {samples}; filter {:?}; ulps {}; kernel {:016x}; aov [{}]",
         env!("CARGO_PKG_VERSION"),
         fingerprint(&(
             &scene.camera,
@@ -134,16 +140,55 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         )
         .into());
     }
+    let frames: Vec<u32> = match (args.frame, args.frames) {
+        (Some(f), _) => vec![f],
+        (None, Some(range)) => range.frames().collect(),
+        (None, None) => vec![0],
+    };
+    if frames.len() > 1 && frame_path(&args.output, 0).is_none() {
+        return Err(LoadError::invalid(
+            &args.output,
+            "several frames need a # in the output name for the frame number, e.g. turn_####.png",
+        )
+        .into());
+    }
     let pool = thread_pool(args.threads)?;
     let mut prepared = prepare(&args.scene, &args.mesh, &args.kernel)?;
-    let scene = &mut prepared.scene;
-    args.size.apply(&mut scene.camera)?;
-    let precision = precision(&args.kernel, &scene.camera)?;
+    args.size.apply(&args.scene, &mut prepared.scene)?;
     let plan = EffectPlan {
         trims: prepared.trims,
-        ..EffectPlan::for_scene(scene)
+        ..EffectPlan::for_scene(&prepared.scene)
     };
     eprintln!("{plan}");
+    let still = prepared.scene.camera.clone();
+    for frame in frames {
+        if let Some(path) = &prepared.scene.animation {
+            let camera = path.camera_at(&still, frame);
+            let forward = camera.look_at - camera.eye;
+            anyhow::ensure!(
+                forward.cross(camera.up).length_squared() > 0.0
+                    && camera.fov_y > 0.0
+                    && camera.fov_y < 180.0,
+                "frame {frame}: the interpolated camera looks along its up direction or has no field of view"
+            );
+            prepared.scene.camera = camera;
+        }
+        let output = frame_path(&args.output, frame).unwrap_or_else(|| args.output.clone());
+        render_frame(&prepared, &args, &pool, (frame, plan), &output)?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Renders one frame of the prepared scene, whose camera is posed for it, to `output`.
+fn render_frame(
+    prepared: &Prepared,
+    args: &RenderArgs,
+    pool: &rayon::ThreadPool,
+    (frame, plan): (u32, EffectPlan),
+    output: &Path,
+) -> anyhow::Result<()> {
+    let scene = &prepared.scene;
+    let precision = precision(&args.kernel, &scene.camera)?;
     let integrator = Integrator {
         scene,
         geometry: &prepared.geometry,
@@ -169,18 +214,19 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     };
     crate::scene::check_film_pixels(window.width(), window.height())
         .map_err(crate::cli::BadArgument)?;
+    let aovs = aov::expand(&args.aov);
     let job = RenderJob {
         order: args.order,
         samples,
         filter: args.filter,
         window,
-        hits: false,
+        hits: aov::needs_hits(&aovs),
     };
     let info = PieceInfo {
         width,
         height,
         window,
-        provenance: provenance(integrator.scene, &args, samples),
+        provenance: provenance(scene, args, samples, frame),
     };
     let bar = progress_bar(args.quiet, "rendering");
     let start = Instant::now();
@@ -198,18 +244,34 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         );
     }
     let start = Instant::now();
-    match ImageFormat::of(&args.output) {
-        Some(ImageFormat::Exr) => write_exr(&args.output, &info, film.rgba_channels())?,
-        _ => write_png(&args.output, &info, &film.to_srgb8())?,
+    let layers = aov::channels(&aovs, &rendered);
+    let mut written = Vec::new();
+    match ImageFormat::of(output) {
+        Some(ImageFormat::Exr) => {
+            let mut channels = film.rgba_channels();
+            channels.extend(layers);
+            write_exr(output, &info, channels)?
+        }
+        _ => {
+            write_png(output, &info, &film.to_srgb8())?;
+            if !layers.is_empty() {
+                let path = sibling(output, "aov", "exr");
+                write_exr(&path, &info, layers)?;
+                written.push(path);
+            }
+        }
     }
-    if args.aov.contains(&Aov::Effort) {
-        let [exr, png] = write_effort(&args.output, film.width, film.height, &rendered.effort)?;
-        if !args.quiet {
-            eprintln!(
-                "wrote effort (splits per pixel) to {} and {}",
-                exr.display(),
-                png.display()
-            );
+    if aovs.contains(&Aov::Effort) {
+        written.push(write_effort_png(
+            output,
+            film.width,
+            film.height,
+            &rendered.effort,
+        )?);
+    }
+    if !args.quiet {
+        for path in &written {
+            eprintln!("wrote {}", path.display());
         }
     }
     let write_seconds = start.elapsed().as_secs_f64();
@@ -235,12 +297,12 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
     if !args.quiet {
         eprintln!(
             "wrote {} ({}x{}, {} rays, {:.3} s)",
-            args.output.display(),
+            output.display(),
             film.width,
             film.height,
             tally.total(),
             render_seconds
         );
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(())
 }

@@ -131,6 +131,25 @@ impl BezierPatch {
         )
     }
 
+    /// The same patch with u and v exchanged (its normal `S_u × S_v` turns around).
+    pub fn transposed(&self) -> BezierPatch {
+        let (nu, nv) = (self.degree_u + 1, self.degree_v + 1);
+        let d = self.domain;
+        BezierPatch {
+            degree_u: self.degree_v,
+            degree_v: self.degree_u,
+            points: (0..nu)
+                .flat_map(|i| (0..nv).map(move |j| self.points[j * nu + i]))
+                .collect(),
+            domain: ParamRect {
+                u0: d.v0,
+                u1: d.v1,
+                v0: d.u0,
+                v1: d.u1,
+            },
+        }
+    }
+
     pub fn with_domain(mut self, domain: ParamRect) -> Self {
         self.domain = domain;
         self

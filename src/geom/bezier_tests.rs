@@ -54,6 +54,14 @@ fn teapot() -> Vec<BezierPatch> {
 
 proptest! {
     #[test]
+    fn transposed_exchanges_the_parameters(p in random_patch(), u in 0.0f64..=1.0, v in 0.0f64..=1.0) {
+        let t = p.transposed();
+        let (a, b) = (t.eval(v, u), explicit_eval(&p, u, v));
+        prop_assert!((a - b).length() <= 1e-12 * (1.0 + b.length()), "{a} vs {b}");
+        prop_assert_eq!((t.degree_u(), t.degree_v()), (p.degree_v(), p.degree_u()));
+    }
+
+    #[test]
     fn de_casteljau_equals_the_bernstein_sum(p in random_patch(), u in 0.0f64..=1.0, v in 0.0f64..=1.0) {
         let a = p.eval(u, v);
         let b = explicit_eval(&p, u, v);

@@ -143,34 +143,27 @@ impl Film {
     }
 }
 
-/// Writes the effort AOV: `<stem>-effort.exr` with one `effort` channel (splits per pixel,
-/// f32) and `<stem>-effort.png`, colour-mapped from 0 to the largest count with a legend.
-/// Returns the two paths.
-pub fn write_effort(
+/// Draws the effort AOV (splits per pixel) as `<stem>-effort.png`, colour-mapped on a log
+/// scale from 0 to the largest count, with a legend. Returns the path.
+pub fn write_effort_png(
     image_path: &Path,
     width: u32,
     height: u32,
     effort: &[u32],
-) -> Result<[std::path::PathBuf; 2], LoadError> {
-    use exr::prelude::*;
+) -> Result<std::path::PathBuf, LoadError> {
+    let png_path = sibling(image_path, "effort", "png");
+    let values: Vec<f32> = effort.iter().map(|&e| e as f32).collect();
+    let max = values.iter().copied().fold(1.0f32, f32::max).ln_1p();
+    let normalized: Vec<f32> = values.iter().map(|v| v.ln_1p() / max).collect();
+    crate::diff::heatmap::heat_map(&normalized, width, height).write_png(&png_path)?;
+    Ok(png_path)
+}
+
+/// `<stem>-<suffix>.<ext>` beside `image_path`.
+pub fn sibling(image_path: &Path, suffix: &str, ext: &str) -> std::path::PathBuf {
     let stem = image_path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let exr_path = image_path.with_file_name(format!("{stem}-effort.exr"));
-    let png_path = image_path.with_file_name(format!("{stem}-effort.png"));
-    let (w, h) = (width as usize, height as usize);
-    let values: Vec<f32> = effort.iter().map(|&e| e as f32).collect();
-    let channel = AnyChannel::new("effort", FlatSamples::F32(values.clone()));
-    let image = Image::from_channels((w, h), AnyChannels::sort(SmallVec::from_elem(channel, 1)));
-    let tmp = temporary_name(&exr_path);
-    image.write().to_file(&tmp).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        LoadError::invalid(&exr_path, format!("writing EXR: {e}"))
-    })?;
-    std::fs::rename(&tmp, &exr_path).map_err(|e| LoadError::io(&exr_path, e))?;
-    let max = values.iter().copied().fold(1.0f32, f32::max).ln_1p();
-    let normalized: Vec<f32> = values.iter().map(|v| v.ln_1p() / max).collect();
-    crate::diff::heatmap::heat_map(&normalized, width, height).write_png(&png_path)?;
-    Ok([exr_path, png_path])
+    image_path.with_file_name(format!("{stem}-{suffix}.{ext}"))
 }

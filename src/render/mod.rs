@@ -2,6 +2,7 @@
 //! effect plan, the film and image output, sampling orders (LG90 §5), windows and tiles,
 //! and statistics.
 
+pub mod aov;
 pub mod camera;
 pub mod film;
 pub mod integrator;

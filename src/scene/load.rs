@@ -4,7 +4,7 @@ use std::path::Path;
 
 use super::error::LoadError;
 use super::model::Material;
-use super::model::{Geometry, Object, Scene, Surface};
+use super::model::{Axis, Geometry, Object, Scene, Surface};
 use super::{bpt, cage, gltf_mesh, iges, mesh, obj, pbrt, ron_format, step};
 
 /// The kinds of input file we read, by extension.
@@ -77,6 +77,34 @@ pub fn load_geometry(path: &Path) -> Result<Geometry, LoadError> {
             "a scene cannot be used as geometry; reference its geometry files instead",
         )),
     }
+}
+
+/// The up axis a format's convention gives bare geometry: y for glTF (glTF 2.0 §3.4, "glTF
+/// uses a right-handed coordinate system ... +Y is up"), z for everything else (CAD
+/// formats, and ours).
+pub fn default_up(kind: InputKind) -> Axis {
+    match kind {
+        InputKind::Gltf => Axis::Y,
+        _ => Axis::Z,
+    }
+}
+
+/// Frames bare geometry read from `path` again after `--width`/`--height` (the fit depends
+/// on the aspect ratio) with `up` pointing up, or its format's default. A RON scene has its
+/// own camera: it is left alone, and `--up` is refused there.
+pub fn reframe(path: &Path, scene: &mut Scene, up: Option<Axis>) -> Result<(), LoadError> {
+    let kind = InputKind::of(path).ok_or_else(|| unknown_kind(path))?;
+    if kind == InputKind::Ron {
+        return match up {
+            Some(_) => Err(LoadError::invalid(
+                path,
+                "--up frames bare geometry; in a scene, set the camera, or give an object `up: Y`",
+            )),
+            None => Ok(()),
+        };
+    }
+    scene.frame_bare(up.unwrap_or(default_up(kind)));
+    Ok(())
 }
 
 /// Reads a polygon mesh file (OBJ polygons, glTF triangles) as a Catmull–Clark cage.
@@ -316,9 +344,13 @@ fn bare_scene(path: &Path, geometry: Geometry) -> Scene {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    Scene::framing(vec![Object {
-        name,
-        material: 0,
-        geometry,
-    }])
+    let kind = InputKind::of(path).unwrap_or(InputKind::Bpt);
+    Scene::framing_up(
+        vec![Object {
+            name,
+            material: 0,
+            geometry,
+        }],
+        default_up(kind),
+    )
 }

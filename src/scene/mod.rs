@@ -4,6 +4,7 @@
 //! reports errors as `file:line:col: what was
 //! expected`; every writer writes to a temporary name and renames.
 
+pub mod animation;
 pub mod bpt;
 pub mod cage;
 pub mod convert;

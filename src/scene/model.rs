@@ -132,6 +132,18 @@ impl Surface {
         }
     }
 
+    /// The same surface seen from its other side: u and v exchanged in the geometry, the
+    /// loops and their parameter maps, so the normal `S_u × S_v` turns around and nothing
+    /// else moves (a STEP face whose `same_sense` is false, ISO 10303-42 §5.4.23).
+    pub fn flip_sides(&mut self) {
+        self.geometry = match &self.geometry {
+            SurfaceGeometry::Bezier(p) => SurfaceGeometry::Bezier(p.transposed()),
+            SurfaceGeometry::Nurbs(n) => SurfaceGeometry::Nurbs(n.transposed()),
+        };
+        self.trims = self.trims.iter().map(TrimLoop::transposed).collect();
+        self.trim_space.swap(0, 1);
+    }
+
     /// The region the trim loops keep, `None` without loops; an error for loops that cannot
     /// be converted (the readers check this at load, [`crate::scene::check_trims`]).
     pub fn trim_region(&self) -> Result<Option<TrimRegion>, TrimError> {
@@ -366,6 +378,56 @@ impl Object {
     }
 }
 
+/// Which coordinate axis of a model points up: glTF models are y-up by specification
+/// (glTF 2.0 §3.4), CAD and our own formats z-up.
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize, serde::Deserialize,
+)]
+pub enum Axis {
+    X,
+    Y,
+    Z,
+}
+
+impl Axis {
+    /// The rotation taking this axis to +z, right-handed, the others cyclically (x-up: x
+    /// → z, y → x; y-up: y → z, z → -y), so a model stands in a z-up scene.
+    pub fn to_z_up(self) -> glam::DMat3 {
+        match self {
+            Axis::X => glam::DMat3::from_cols(DVec3::Z, DVec3::X, DVec3::Y),
+            Axis::Y => glam::DMat3::from_rotation_x(std::f64::consts::FRAC_PI_2),
+            Axis::Z => glam::DMat3::IDENTITY,
+        }
+    }
+
+    /// A direction given in the z-up frame, in the frame where this axis is up.
+    pub fn from_z_up(self, v: DVec3) -> DVec3 {
+        self.to_z_up().transpose() * v
+    }
+}
+
+#[cfg(test)]
+mod axis_tests {
+    use super::*;
+
+    #[test]
+    fn each_up_axis_turns_to_z_by_a_rotation_and_back() {
+        for (axis, v) in [
+            (Axis::X, DVec3::X),
+            (Axis::Y, DVec3::Y),
+            (Axis::Z, DVec3::Z),
+        ] {
+            let m = axis.to_z_up();
+            assert!((m * v - DVec3::Z).length() < 1e-15, "{axis:?}");
+            assert!((m.determinant() - 1.0).abs() < 1e-15);
+            assert!((m * m.transpose()).abs_diff_eq(glam::DMat3::IDENTITY, 1e-15));
+            assert!((axis.from_z_up(DVec3::Z) - v).length() < 1e-15);
+        }
+        // glTF's front (+z, y up) is the z-up scene's front (-y): the viewer looks at it.
+        assert!((Axis::Y.to_z_up() * DVec3::Z - -DVec3::Y).length() < 1e-15);
+    }
+}
+
 /// Everything needed to render.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scene {
@@ -377,6 +439,8 @@ pub struct Scene {
     pub max_depth: u32,
     /// Samples per pixel, unless `render --spp` says otherwise (`None`: one).
     pub samples: Option<u32>,
+    /// How the camera moves over the frames of an animation; `None`: it stands still.
+    pub animation: Option<super::animation::CameraPath>,
     pub lights: Vec<Light>,
     pub materials: Vec<Material>,
     pub objects: Vec<Object>,
@@ -394,9 +458,15 @@ impl Scene {
             .fold(DAabb::EMPTY, |acc, o| acc.union(&o.bounds()))
     }
 
-    /// A scene for bare geometry: a camera that frames it from the front-left and above,
-    /// and one point light near the camera (DESIGN.md: bare geometry as a scene).
+    /// A scene for bare geometry, z up: a camera that frames it and one light
+    /// ([`Scene::frame_bare`]).
     pub fn framing(objects: Vec<Object>) -> Scene {
+        Scene::framing_up(objects, Axis::Z)
+    }
+
+    /// A scene for bare geometry whose `up` axis points up (DESIGN.md: bare geometry as a
+    /// scene).
+    pub fn framing_up(objects: Vec<Object>, up: Axis) -> Scene {
         let mut scene = Scene {
             camera: Camera {
                 eye: DVec3::new(0.0, -5.0, 0.0),
@@ -410,27 +480,43 @@ impl Scene {
             ambient: DEFAULT_AMBIENT,
             max_depth: DEFAULT_MAX_DEPTH,
             samples: None,
+            animation: None,
             lights: Vec::new(),
             materials: vec![Material::default_named("default")],
             objects,
         };
-        let b = scene.bounds();
+        scene.frame_bare(up);
+        scene
+    }
+
+    /// Points the camera at the geometry from the front-left and above, as seen with `up`
+    /// pointing up, far enough that the bounding sphere fits the narrower field of view,
+    /// and puts the one light above and beside the camera.
+    pub fn frame_bare(&mut self, up: Axis) {
+        let b = self.bounds();
         let (center, radius) = if b.is_empty() {
             (DVec3::ZERO, 1.0)
         } else {
             (b.center(), (0.5 * b.diagonal()).max(f64::MIN_POSITIVE))
         };
-        // Distance at which a sphere of this radius fits the vertical field of view.
-        let half_fov = (scene.camera.fov_y.to_radians() * 0.5).sin();
-        let distance = radius / half_fov * 1.1;
-        let view = DVec3::new(0.35, -1.0, 0.45).normalize();
-        scene.camera.eye = center + view * distance;
-        scene.camera.look_at = center;
-        scene.lights.push(Light::Point {
-            position: center + DVec3::new(1.0, -1.0, 1.5).normalize() * distance,
+        // Distance at which a sphere of this radius fits the field of view: the vertical
+        // one, or the horizontal one of a portrait image.
+        let c = &self.camera;
+        let half_y = c.fov_y.to_radians() * 0.5;
+        let half = if c.width >= c.height {
+            half_y
+        } else {
+            (half_y.tan() * c.width as f64 / c.height as f64).atan()
+        };
+        let distance = radius / half.sin() * 1.1;
+        let view = up.from_z_up(DVec3::new(0.35, -1.0, 0.45)).normalize();
+        self.camera.eye = center + view * distance;
+        self.camera.look_at = center;
+        self.camera.up = up.from_z_up(DVec3::Z);
+        self.lights = vec![Light::Point {
+            position: center + up.from_z_up(DVec3::new(1.0, -1.0, 1.5)).normalize() * distance,
             intensity: Vec3::ONE,
-        });
-        scene
+        }];
     }
 
     pub fn patch_count(&self) -> usize {

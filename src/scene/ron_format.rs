@@ -8,6 +8,7 @@ use std::sync::Arc;
 use glam::{DAffine3, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
+use super::animation::{CameraKey, CameraPath};
 use super::error::{LoadError, ParseError};
 use super::model::*;
 use super::ron_locate::RonLocator;
@@ -52,6 +53,39 @@ pub struct CameraDef {
     pub fov_y: f64,
     pub width: u32,
     pub height: u32,
+    /// A turntable: `orbit: (frames: 24, degrees: 360)` turns the eye about `look_at`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orbit: Option<OrbitDef>,
+    /// Keyframes: `keyframes: [(frame: 0, eye: (…)), (frame: 24, eye: (…), fov_y: 30)]`;
+    /// fields a key leaves out are the camera's.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub keyframes: Vec<KeyDef>,
+}
+
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OrbitDef {
+    pub frames: u32,
+    #[serde(default = "full_turn")]
+    pub degrees: f64,
+}
+
+fn full_turn() -> f64 {
+    360.0
+}
+
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KeyDef {
+    pub frame: u32,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eye: Option<V3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub look_at: Option<V3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub up: Option<V3>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fov_y: Option<f64>,
 }
 
 #[derive(Debug, Serialize, Deserialize)]
@@ -105,6 +139,10 @@ pub struct ObjectDef {
     pub geometry: GeometryDef,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
+    /// The axis that is up in the object's geometry (`X`, `Y` or `Z`, default `Z`): a
+    /// y-up model is turned to stand in the z-up scene before its transforms.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub up: Option<Axis>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub transform: Vec<TransformDef>,
 }
@@ -274,6 +312,7 @@ fn build_scene(path: &Path, at: &RonLocator, file: SceneFile) -> Result<Scene, L
         height: c.height,
     };
     validate_camera(&camera).map_err(|m| at.at_key("camera", m))?;
+    let animation = camera_path(at, c, &camera)?;
     let max_spp = crate::render::sampler::MAX_SPP;
     if let Some(n) = file.samples
         && !(1..=max_spp).contains(&n)
@@ -332,11 +371,15 @@ fn build_scene(path: &Path, at: &RonLocator, file: SceneFile) -> Result<Scene, L
                 };
                 Geometry::Instance(Instance::new(shared.geometry.clone(), DAffine3::IDENTITY))
             }
-            GeometryDef::File(f) => super::load::load_geometry(&base.join(f))
-                .map_err(|e| referenced(at, index, f, e))?,
+            GeometryDef::File(f) => {
+                super::load::load_geometry(&base.join(file_name(at, index, f)?))
+                    .map_err(|e| referenced(at, index, f, e))?
+            }
             GeometryDef::Subdivision(inner) => match inner.as_ref() {
-                GeometryDef::File(f) => super::load::load_subdivision(&base.join(f))
-                    .map_err(|e| referenced(at, index, f, e))?,
+                GeometryDef::File(f) => {
+                    super::load::load_subdivision(&base.join(file_name(at, index, f)?))
+                        .map_err(|e| referenced(at, index, f, e))?
+                }
                 _ => {
                     return Err(at
                         .at_object(
@@ -359,10 +402,8 @@ fn build_scene(path: &Path, at: &RonLocator, file: SceneFile) -> Result<Scene, L
                     .collect::<Result<_, _>>()?,
             ),
         };
-        let m = o
-            .transform
-            .iter()
-            .fold(DAffine3::IDENTITY, |acc, t| t.to_affine() * acc);
+        let stand = DAffine3::from_mat3(o.up.unwrap_or(Axis::Z).to_z_up());
+        let m = o.transform.iter().fold(stand, |acc, t| t.to_affine() * acc);
         let name = o.name.clone().unwrap_or_else(|| match &o.geometry {
             GeometryDef::Instance { of } => of.clone(),
             GeometryDef::File(f) => f.clone(),
@@ -412,10 +453,87 @@ fn build_scene(path: &Path, at: &RonLocator, file: SceneFile) -> Result<Scene, L
         ambient: file.ambient.unwrap_or(DEFAULT_AMBIENT),
         max_depth: file.max_depth.unwrap_or(DEFAULT_MAX_DEPTH),
         samples: file.samples,
+        animation,
         lights,
         materials,
         objects,
     })
+}
+
+/// The file name of a `File(...)`, refused when empty (joined to the scene's directory it
+/// would name the directory itself).
+fn file_name<'a>(at: &RonLocator, index: usize, f: &'a str) -> Result<&'a str, LoadError> {
+    if f.trim().is_empty() {
+        return Err(at
+            .at_object(
+                index,
+                format!("object {index}: expected a geometry file name in File(\"...\"), found an empty string"),
+            )
+            .into());
+    }
+    Ok(f)
+}
+
+/// The camera's animation, checked: an orbit has at least one frame and a finite angle;
+/// keyframes are in increasing frame order and each is a valid camera.
+fn camera_path(
+    at: &RonLocator,
+    def: &CameraDef,
+    camera: &Camera,
+) -> Result<Option<CameraPath>, ParseError> {
+    match (&def.orbit, def.keyframes.is_empty()) {
+        (Some(_), false) => {
+            Err(at.at_key("orbit", "camera: give either orbit or keyframes, not both"))
+        }
+        (Some(o), true) => {
+            if o.frames == 0 || !o.degrees.is_finite() {
+                return Err(at.at_key(
+                    "orbit",
+                    "camera: orbit needs frames >= 1 and a finite number of degrees",
+                ));
+            }
+            Ok(Some(CameraPath::Orbit {
+                frames: o.frames,
+                degrees: o.degrees,
+            }))
+        }
+        (None, true) => Ok(None),
+        (None, false) => {
+            let mut keys = Vec::with_capacity(def.keyframes.len());
+            for (i, k) in def.keyframes.iter().enumerate() {
+                if let Some(prev) = keys.last().map(|p: &CameraKey| p.frame)
+                    && k.frame <= prev
+                {
+                    return Err(at.at_key(
+                        "keyframes",
+                        format!(
+                            "camera: keyframe {i} (frame {}) does not come after frame {prev}",
+                            k.frame
+                        ),
+                    ));
+                }
+                let key = CameraKey {
+                    frame: k.frame,
+                    eye: k.eye.map_or(camera.eye, v3),
+                    look_at: k.look_at.map_or(camera.look_at, v3),
+                    up: k.up.map_or(camera.up, v3),
+                    fov_y: k.fov_y.unwrap_or(camera.fov_y),
+                };
+                let posed = Camera {
+                    eye: key.eye,
+                    look_at: key.look_at,
+                    up: key.up,
+                    fov_y: key.fov_y,
+                    ..camera.clone()
+                };
+                if let Err(message) = validate_camera(&posed) {
+                    return Err(at.at_key("keyframes", format!("keyframe {i}: {message}")));
+                }
+                keys.push(key);
+            }
+            Ok(Some(CameraPath::Keys(keys)))
+        }
+    }
 }
 
 /// An error loading the geometry file `file` of object `index`: the file's own parse
@@ -751,6 +869,7 @@ pub fn scene_to_file(scene: &Scene) -> Result<SceneFile, String> {
             name: Some(o.name.clone()),
             geometry: GeometryDef::Surfaces(defs),
             material: Some(scene.materials[o.material].name.clone()),
+            up: None,
             transform: Vec::new(),
         });
     }
@@ -762,6 +881,26 @@ pub fn scene_to_file(scene: &Scene) -> Result<SceneFile, String> {
             fov_y: c.fov_y,
             width: c.width,
             height: c.height,
+            orbit: match &scene.animation {
+                Some(CameraPath::Orbit { frames, degrees }) => Some(OrbitDef {
+                    frames: *frames,
+                    degrees: *degrees,
+                }),
+                _ => None,
+            },
+            keyframes: match &scene.animation {
+                Some(CameraPath::Keys(keys)) => keys
+                    .iter()
+                    .map(|k| KeyDef {
+                        frame: k.frame,
+                        eye: Some(t(k.eye)),
+                        look_at: Some(t(k.look_at)),
+                        up: Some(t(k.up)),
+                        fov_y: Some(k.fov_y),
+                    })
+                    .collect(),
+                _ => Vec::new(),
+            },
         },
         background: tc(scene.background),
         ambient: Some(scene.ambient),

@@ -71,3 +71,28 @@ pub fn trace_rows(scene: &Path, rays: &str, extra: &[&str]) -> Vec<Vec<String>> 
         .map(|l| l.split(',').map(str::to_string).collect())
         .collect()
 }
+
+/// The hit point and normal of each ray `(origin, direction)` through `trace`, `None` for a
+/// miss.
+pub fn trace_hits(
+    scene: &Path,
+    rays: &[(glam::DVec3, glam::DVec3)],
+) -> Vec<Option<(glam::DVec3, glam::DVec3)>> {
+    let text: String = rays
+        .iter()
+        .map(|(o, d)| format!("{} {} {} {} {} {}\n", o.x, o.y, o.z, d.x, d.y, d.z))
+        .collect();
+    trace_rows(scene, &text, &[])
+        .iter()
+        .map(|f| {
+            let v = |k: usize| {
+                glam::DVec3::new(
+                    f[k].parse().unwrap(),
+                    f[k + 1].parse().unwrap(),
+                    f[k + 2].parse().unwrap(),
+                )
+            };
+            (f[1] == "1").then(|| (v(7), v(10)))
+        })
+        .collect()
+}

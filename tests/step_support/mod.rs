@@ -149,7 +149,16 @@ impl StepWriter {
     }
 
     pub fn face(&mut self, bounds: &[u64], surface: u64) -> u64 {
-        let f = self.add(format!("ADVANCED_FACE('',{},#{surface},.T.)", refs(bounds)));
+        self.face_with_sense(bounds, surface, true)
+    }
+
+    /// A face whose normal is its surface's (`same_sense` true) or the opposite.
+    pub fn face_with_sense(&mut self, bounds: &[u64], surface: u64, same_sense: bool) -> u64 {
+        let sense = if same_sense { ".T." } else { ".F." };
+        let f = self.add(format!(
+            "ADVANCED_FACE('',{},#{surface},{sense})",
+            refs(bounds)
+        ));
         self.faces.push(f);
         f
     }

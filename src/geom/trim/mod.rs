@@ -112,6 +112,26 @@ impl TrimSegment {
 }
 
 impl TrimLoop {
+    /// The loop with its two parameters exchanged, exactly (each homogeneous point
+    /// `(w x, w y, w)` becomes `(w y, w x, w)`), for a surface that was transposed.
+    pub fn transposed(&self) -> TrimLoop {
+        let segments = self
+            .segments
+            .iter()
+            .map(|s| {
+                let mut s = s.clone();
+                for p in &mut s.curve.points {
+                    std::mem::swap(&mut p.x, &mut p.y);
+                }
+                s
+            })
+            .collect();
+        TrimLoop {
+            hole: self.hole,
+            segments,
+        }
+    }
+
     /// A loop of one closed curve, taken over its whole domain.
     pub fn closed(curve: ParamCurve, hole: bool) -> TrimLoop {
         let (t0, t1) = curve.domain();

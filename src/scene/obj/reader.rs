@@ -771,9 +771,15 @@ fn resolve_index(path: &Path, tok: &Token, count: usize, what: &str) -> Result<u
         )));
     };
     resolved.ok_or_else(|| {
-        error(format!(
-            "dangling {what} index `{}`: expected 1 to {count} or -{count} to -1 ({count} defined so far)",
-            tok.text
-        ))
+        error(match count {
+            0 => format!(
+                "dangling {what} index `{}`: no {what} is defined before this line",
+                tok.text
+            ),
+            _ => format!(
+                "dangling {what} index `{}`: expected 1 to {count} or -{count} to -1 ({count} defined so far)",
+                tok.text
+            ),
+        })
     })
 }

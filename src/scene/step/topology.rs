@@ -246,11 +246,23 @@ impl Domain<'_> {
         }
         let (curve, _) = curve_to_nurbs(&pc.curve, [ta, tb]).ok()?;
         let (d0, d1) = crate::geom::nurbs::knots::domain(curve.degree, &curve.knots);
-        Some(TrimSegment {
-            t0: ta.max(d0),
-            t1: tb.min(d1),
-            curve: as_param(&curve),
-        })
+        let mut piece = Piece::new(
+            TrimSegment {
+                t0: ta.max(d0),
+                t1: tb.min(d1),
+                curve: as_param(&curve),
+            },
+            false,
+        );
+        // A sphere's latitude is only meaningful in [-π/2, π/2], but its closed form is
+        // 2π-periodic, so a pcurve may agree with its edge a whole turn away (OpenCASCADE
+        // writes the seam of a hemisphere at v = t − 2π): bring it back by whole turns.
+        if let SurfaceDef::Sphere { .. } = self.def {
+            let mid = 0.5 * (piece.start().y + piece.end().y);
+            let turns = (mid / std::f64::consts::TAU).round();
+            piece.shift(DVec2::new(0.0, -turns * std::f64::consts::TAU));
+        }
+        Some(piece.seg)
     }
 }
 
@@ -483,12 +495,16 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
                 .collect(),
         });
     }
+    let mut surface = Surface {
+        geometry: SurfaceGeometry::Nurbs(nurbs),
+        trims,
+        trim_space,
+    };
+    if !face.same_sense {
+        surface.flip_sides();
+    }
     Ok(FaceOutcome {
-        surface: Surface {
-            geometry: SurfaceGeometry::Nurbs(nurbs),
-            trims,
-            trim_space,
-        },
+        surface,
         projection_error,
         projected_edges,
     })
