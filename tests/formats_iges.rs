@@ -645,3 +645,556 @@ fn hammer_from_iges_is_the_hammer_from_obj() {
         }
     }
 }
+
+// ---------------------------------------------------------------------------------------
+// 114, 190–198, 141/143, hyperbolic 104.
+
+/// A global bicubic polynomial surface, coefficients g[d][a + 4 b] of u^a v^b.
+fn poly_surface() -> [[f64; 16]; 3] {
+    let mut g = [[0.0; 16]; 3];
+    g[0][1] = 1.0; // x = u + 0.1 u v²
+    g[0][1 + 8] = 0.1;
+    g[1][4] = 1.0; // y = v + 0.2 u³ − 0.05 u² v³
+    g[1][3] = 0.2;
+    g[1][2 + 12] = -0.05;
+    g[2][0] = 0.2; // z = 0.2 − 0.5 u v + 0.3 u² v³ + 0.1 u³ v
+    g[2][1 + 4] = -0.5;
+    g[2][2 + 12] = 0.3;
+    g[2][3 + 4] = 0.1;
+    g
+}
+
+fn poly_eval(g: &[[f64; 16]; 3], u: f64, v: f64) -> DVec3 {
+    let c = |d: usize| {
+        (0..16)
+            .map(|k| g[d][k] * u.powi((k % 4) as i32) * v.powi((k / 4) as i32))
+            .sum::<f64>()
+    };
+    DVec3::new(c(0), c(1), c(2))
+}
+
+fn binomial(n: usize, k: usize) -> f64 {
+    (0..k).fold(1.0, |acc, i| acc * (n - i) as f64 / (i + 1) as f64)
+}
+
+/// The polynomial re-expanded about (u0, v0) (Taylor shift), as a 114 patch stores it.
+fn shifted(g: &[[f64; 16]; 3], u0: f64, v0: f64) -> Vec<f64> {
+    let mut out = Vec::new();
+    for gd in g {
+        for k in 0..16 {
+            let (a, b) = (k % 4, k / 4);
+            let mut c = 0.0;
+            for a2 in a..4 {
+                for b2 in b..4 {
+                    c += gd[a2 + 4 * b2]
+                        * binomial(a2, a)
+                        * binomial(b2, b)
+                        * u0.powi((a2 - a) as i32)
+                        * v0.powi((b2 - b) as i32);
+                }
+            }
+            out.push(c);
+        }
+    }
+    out
+}
+
+#[test]
+fn parametric_spline_surface_of_two_by_two_patches() {
+    let g = poly_surface();
+    let (tu, tv) = ([0.0, 0.4, 1.0], [-1.0, 0.0, 0.5]);
+    let mut p = vec![3.0, 0.0, 2.0, 2.0];
+    p.extend(tu);
+    p.extend(tv);
+    for &u0 in &tu[..2] {
+        for &v0 in &tv[..2] {
+            p.extend(shifted(&g, u0, v0));
+        }
+        p.extend([0.0; 48]); // the arbitrary values after each row
+    }
+    p.extend([0.0; 48 * 3]);
+    let mut s114 = ent(114, &p);
+    s114.subordinate = 0;
+    let read = read(&[s114]);
+    let (s, surface) = only(&read);
+    assert!(surface.trims.is_empty());
+    assert_eq!((s.degree_u, s.degree_v, s.count_u, s.count_v), (3, 3, 7, 7));
+    for (a, b) in grid() {
+        let (u, v) = (a, -1.0 + 1.5 * b);
+        close(s.eval(u, v), poly_eval(&g, u, v), 2.0, "114");
+    }
+}
+
+/// An entity that is a 116 point or a 123 direction.
+fn vector(ty: i32, v: DVec3) -> Ent {
+    ent(ty, &[v.x, v.y, v.z])
+}
+
+/// The frame of a parameterised 190–198: X the reference made orthogonal to the axis.
+fn frame(axis: DVec3, reference: DVec3) -> [DVec3; 3] {
+    let z = axis.normalize();
+    let x = (reference - z * reference.dot(z)).normalize();
+    [x, z.cross(x), z]
+}
+
+#[test]
+fn analytic_surfaces_in_their_standard_parameterisation_with_parameter_space_trims() {
+    let centre = DVec3::new(1.0, -2.0, 0.5);
+    let (axis, reference) = (DVec3::new(0.2, 0.3, 1.0), DVec3::new(1.0, 0.5, 0.0));
+    let [x, y, z] = frame(axis, reference);
+    let (r, big, alpha) = (1.5, 3.0, 20f64.to_radians());
+    // (type, parameters after the three pointers' slots, the definition, the trim box)
+    type Def = Box<dyn Fn(f64, f64) -> DVec3>;
+    let ring = move |u: f64| x * u.cos() + y * u.sin();
+    let cases: Vec<(i32, Vec<f64>, Def, [f64; 4])> = vec![
+        (
+            190,
+            vec![de(0), de(1), de(2)],
+            Box::new(move |u, v| centre + x * u + y * v),
+            [-1.0, 2.0, -0.5, 1.5],
+        ),
+        (
+            192,
+            vec![de(0), de(1), r, de(2)],
+            Box::new(move |u, v| centre + ring(u) * r + z * v),
+            [0.3, 2.5, -1.0, 2.0],
+        ),
+        (
+            194,
+            vec![de(0), de(1), r, alpha.to_degrees(), de(2)],
+            Box::new(move |u, v| centre + ring(u) * (r + v * alpha.tan()) + z * v),
+            [-2.0, 3.0, -1.0, 2.0],
+        ),
+        (
+            196,
+            vec![de(0), r, de(1), de(2)],
+            Box::new(move |u, v| centre + ring(u) * (r * v.cos()) + z * (r * v.sin())),
+            [0.5, 5.5, -1.2, 0.9],
+        ),
+        (
+            198,
+            vec![de(0), de(1), big, r, de(2)],
+            Box::new(move |u, v| centre + ring(u) * (big + r * v.cos()) + z * (r * v.sin())),
+            [-1.0, 1.5, 0.2, 6.0],
+        ),
+    ];
+    for (ty, params, def, [u0, u1, v0, v1]) in cases {
+        let mut surface = ent(ty, &params);
+        surface.form = 1;
+        // 0: 116; 1: 123 axis; 2: 123 reference; 3: surface; 4: 106 loop in (u, v);
+        // 5: 142; 6: 144.
+        let corners = [(u0, v0), (u1, v0), (u1, v1), (u0, v1), (u0, v0)];
+        let mut loop_points = vec![1.0, 5.0, 0.0];
+        for (u, v) in corners {
+            loop_points.extend([u, v]);
+        }
+        let mut polygon = ent(106, &loop_points);
+        polygon.form = 63;
+        let mut top = ent(144, &[de(3), 1.0, 0.0, de(5)]);
+        top.subordinate = 0;
+        let read = read(&[
+            vector(116, centre),
+            vector(123, axis),
+            vector(123, reference),
+            surface,
+            polygon,
+            ent(142, &[0.0, de(3), de(4), 0.0, 1.0]),
+            top,
+        ]);
+        let (s, trimmed) = only(&read);
+        let d = s.domain();
+        let maps = &trimmed.trim_space;
+        // The patch covers the trim box, and its points are the definition's at the
+        // mapped parameters.
+        let (a0, a1) = (maps[0].apply(d.u0), maps[0].apply(d.u1));
+        let (b0, b1) = (maps[1].apply(d.v0), maps[1].apply(d.v1));
+        assert!(
+            (a0 - u0).abs() < 1e-12 && (a1 - u1).abs() < 1e-12,
+            "{ty}: u {a0} {a1}"
+        );
+        assert!(
+            (b0 - v0).abs() < 1e-12 && (b1 - v1).abs() < 1e-12,
+            "{ty}: v {b0} {b1}"
+        );
+        for (a, b) in grid() {
+            let (u, v) = d.to_parent(a, b);
+            let want = def(maps[0].apply(u), maps[1].apply(v));
+            close(s.eval(u, v), want, 6.0, &format!("{ty}"));
+        }
+        let seg = &trimmed.trims[0].segments[0];
+        for (k, (u, v)) in corners.iter().enumerate() {
+            assert!((trim_point(&seg.curve, k as f64) - DVec2::new(*u, *v)).length() < REL);
+        }
+    }
+}
+
+#[test]
+fn closed_analytic_surfaces_draw_whole_and_unbounded_ones_are_named() {
+    let centre = DVec3::new(0.5, 0.0, -1.0);
+    let mut sphere = ent(196, &[de(0), 2.0]);
+    sphere.subordinate = 0;
+    let mut torus = ent(198, &[de(0), de(1), 3.0, 1.0]);
+    torus.subordinate = 0;
+    let mut cylinder = ent(192, &[de(0), de(1), 1.0]);
+    cylinder.subordinate = 0;
+    let read = read(&[
+        vector(116, centre),
+        vector(123, DVec3::Z),
+        sphere,
+        torus,
+        cylinder,
+    ]);
+    assert_eq!(read.surfaces.len(), 2, "{:?}", read.report.failed);
+    assert_eq!(read.report.failed.len(), 1);
+    assert!(read.report.failed[0].starts_with("entity 192 (D 9): "));
+    for (k, drawn) in read.surfaces.iter().enumerate() {
+        let SurfaceGeometry::Nurbs(s) = &drawn.surface.geometry else {
+            panic!()
+        };
+        let maps = &drawn.surface.trim_space;
+        let d = s.domain();
+        for (a, b) in grid() {
+            let (u, v) = d.to_parent(a, b);
+            let l = s.eval(u, v) - centre;
+            let residual = if k == 0 {
+                l.length() - 2.0
+            } else {
+                (l.truncate().length() - 3.0).hypot(l.z) - 1.0
+            };
+            assert!(residual.abs() < 1e-12 * 4.0, "surface {k}: {residual:e}");
+        }
+        let turn = maps[0].apply(d.u1) - maps[0].apply(d.u0);
+        assert!((turn - 2.0 * PI).abs() < 1e-12, "a full turn: {turn}");
+    }
+}
+
+#[test]
+fn unparameterised_cylinder_trimmed_by_a_model_space_curve() {
+    // 192 form 0 about the z axis through the origin, radius 2; the boundary is a 106
+    // form 12 polygon through points on it, given only in model space.
+    let angles_heights = [(0.2, 0.0), (1.5, 0.0), (2.0, 1.0), (0.6, 1.5), (0.2, 0.0)];
+    let mut poly = vec![2.0, angles_heights.len() as f64];
+    for (a, h) in angles_heights {
+        poly.extend([2.0 * f64::cos(a), 2.0 * f64::sin(a), h]);
+    }
+    let mut copious = ent(106, &poly);
+    copious.form = 12;
+    let mut top = ent(144, &[de(2), 1.0, 0.0, de(4)]);
+    top.subordinate = 0;
+    let read = read(&[
+        vector(116, DVec3::ZERO),
+        vector(123, DVec3::Z),
+        ent(192, &[de(0), de(1), 2.0]),
+        copious,
+        ent(142, &[0.0, de(2), 0.0, de(3), 2.0]),
+        top,
+    ]);
+    let (s, trimmed) = only(&read);
+    let d = s.domain();
+    for (a, b) in grid() {
+        let (u, v) = d.to_parent(a, b);
+        assert!((s.eval(u, v).truncate().length() - 2.0).abs() < 1e-12 * 4.0);
+    }
+    // Each polygon vertex, through the trim loop and the surface, is the vertex again.
+    let seg = &trimmed.trims[0].segments[0];
+    let maps = &trimmed.trim_space;
+    for (k, (a, h)) in angles_heights.iter().enumerate() {
+        let uv = trim_point(&seg.curve, (24 * k) as f64);
+        let p = s.eval(maps[0].invert(uv.x), maps[1].invert(uv.y));
+        close(
+            p,
+            DVec3::new(2.0 * a.cos(), 2.0 * a.sin(), *h),
+            4.0,
+            "vertex",
+        );
+    }
+}
+
+#[test]
+fn bounded_surface_of_boundaries_with_reversed_and_model_space_curves() {
+    let n = net();
+    // 1–3: 110 lines in (u, v) (0.1, 0.1) → (0.9, 0.1) → (0.9, 0.9) and, written backwards,
+    // (0.1, 0.1) → (0.9, 0.9) for the closing edge; 4: 141 of two edges (the second
+    // SENSE 2); 5: 100 circle hole in (u, v); 6: 141 of it; 7: 143.
+    let mut bounded = ent(143, &[1.0, de(0), 2.0, de(4), de(6)]);
+    bounded.subordinate = 0;
+    let read = read(&[
+        ent(128, &b128(&n, [0.0, 1.0, 0.0, 1.0])),
+        ent(110, &[0.1, 0.1, 0.0, 0.9, 0.1, 0.0]),
+        ent(110, &[0.9, 0.1, 0.0, 0.9, 0.9, 0.0]),
+        ent(110, &[0.1, 0.1, 0.0, 0.9, 0.9, 0.0]),
+        ent(
+            141,
+            &[
+                1.0,
+                2.0,
+                de(0),
+                2.0,
+                0.0,
+                1.0,
+                2.0,
+                de(1),
+                de(2),
+                0.0,
+                2.0,
+                1.0,
+                de(3),
+            ],
+        ),
+        ent(100, &[0.0, 0.6, 0.3, 0.7, 0.3, 0.7, 0.3]),
+        ent(141, &[1.0, 2.0, de(0), 1.0, 0.0, 1.0, 1.0, de(5)]),
+        bounded,
+    ]);
+    let (_, surface) = only(&read);
+    let [outer, hole]: &[TrimLoop; 2] = surface.trims.as_slice().try_into().unwrap();
+    assert!(!outer.hole && hole.hole);
+    // The loop runs (0.1, 0.1) → (0.9, 0.1) → (0.9, 0.9) → (0.1, 0.1), each segment
+    // starting where the last ended.
+    let vertices = [(0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.1, 0.1)];
+    assert_eq!(outer.segments.len(), 3);
+    for (k, seg) in outer.segments.iter().enumerate() {
+        let (a, b) = (DVec2::from(vertices[k]), DVec2::from(vertices[k + 1]));
+        assert!((trim_point(&seg.curve, seg.t0) - a).length() < REL, "{k}");
+        assert!((trim_point(&seg.curve, seg.t1) - b).length() < REL, "{k}");
+    }
+    let c = &hole.segments[0];
+    let mid = trim_point(&c.curve, 0.5 * (c.t0 + c.t1));
+    assert!(((mid - DVec2::new(0.6, 0.3)).length() - 0.1).abs() < REL);
+}
+
+#[test]
+fn hyperbolic_conic_arc_in_general_position() {
+    let n = net();
+    let (a, b, phi, c) = (0.1, 0.05, 0.4f64, DVec2::new(0.4, 0.5));
+    let (cp, sp) = (phi.cos(), phi.sin());
+    let ka = cp * cp / (a * a) - sp * sp / (b * b);
+    let kb = 2.0 * cp * sp * (1.0 / (a * a) + 1.0 / (b * b));
+    let kc = sp * sp / (a * a) - cp * cp / (b * b);
+    let kd = -2.0 * ka * c.x - kb * c.y;
+    let ke = -kb * c.x - 2.0 * kc * c.y;
+    let kf = ka * c.x * c.x + kb * c.x * c.y + kc * c.y * c.y - 1.0;
+    let on = |t: f64| {
+        let q = DVec2::new(a * t.cosh(), b * t.sinh());
+        c + DVec2::new(cp * q.x - sp * q.y, sp * q.x + cp * q.y)
+    };
+    // Written from t = 0.8 to t = −0.5: the reader orients the arc itself.
+    let (s, e) = (on(0.8), on(-0.5));
+    let mut top = ent(144, &[de(0), 1.0, 1.0, 0.0, de(2)]);
+    top.subordinate = 0;
+    let read = read(&[
+        ent(128, &b128(&n, [0.0, 1.0, 0.0, 1.0])),
+        ent(104, &[ka, kb, kc, kd, ke, kf, 0.0, s.x, s.y, e.x, e.y]),
+        ent(142, &[0.0, de(0), de(1), 0.0, 1.0]),
+        top,
+    ]);
+    let (_, surface) = only(&read);
+    let seg = &surface.trims[0].segments[0];
+    let ends = [
+        trim_point(&seg.curve, seg.t0),
+        trim_point(&seg.curve, seg.t1),
+    ];
+    assert!(
+        (ends[0] - s).length() < REL && (ends[1] - e).length() < REL
+            || (ends[0] - e).length() < REL && (ends[1] - s).length() < REL,
+        "{ends:?}"
+    );
+    for i in 0..=16 {
+        let t = (seg.t0 + (seg.t1 - seg.t0) * i as f64 / 16.0).min(seg.t1);
+        let p = trim_point(&seg.curve, t);
+        let q = ka * p.x * p.x + kb * p.x * p.y + kc * p.y * p.y + kd * p.x + ke * p.y + kf;
+        // The conic's gradient is about 2/b² · b = 40 here: residual 1e-12 · 40 per unit.
+        assert!(q.abs() < 1e-10, "conic residual {q:e}");
+        // On the branch between the ends: its local x is positive.
+        let l = p - c;
+        assert!(cp * l.x + sp * l.y > 0.0);
+    }
+}
+
+#[test]
+fn manifold_solid_b_rep_faces_with_edge_lists_and_loops() {
+    let n = net();
+    let (c, r) = (DVec3::new(0.0, 0.0, 5.0), 1.5);
+    // 0: 128; 1–3: 110 model-space curves (unused: parameter curves are given);
+    // 4–6: 110 parameter curves, the third written backwards; 7: 504; 8: 508 (the third
+    // edge OF 0); 9: 510 on the 128; 10: 116; 11: 196; 12: 510 on the sphere, no loops;
+    // 13: 514; 14: 186 (colour 3, translated by 15: 124).
+    let uv = [(0.1, 0.1), (0.9, 0.1), (0.9, 0.9)];
+    let model = |(u, v): (f64, f64)| net_point(&n, u, v);
+    let mut ents = vec![ent(128, &b128(&n, [0.0, 1.0, 0.0, 1.0]))];
+    for k in 0..3 {
+        let (a, b) = (model(uv[k]), model(uv[(k + 1) % 3]));
+        ents.push(ent(110, &[a.x, a.y, a.z, b.x, b.y, b.z]));
+    }
+    for k in 0..3 {
+        let (a, b) = if k == 2 {
+            (uv[0], uv[2])
+        } else {
+            (uv[k], uv[k + 1])
+        };
+        ents.push(ent(110, &[a.0, a.1, 0.0, b.0, b.1, 0.0]));
+    }
+    let mut edges = vec![3.0];
+    for k in 0..3 {
+        edges.extend([de(1 + k), 0.0, 0.0, 0.0, 0.0]);
+    }
+    ents.push(ent(504, &edges));
+    let mut lp = vec![3.0];
+    for k in 0..3 {
+        let of = if k == 2 { 0.0 } else { 1.0 };
+        lp.extend([0.0, de(7), (k + 1) as f64, of, 1.0, 0.0, de(4 + k)]);
+    }
+    ents.push(ent(508, &lp));
+    ents.push(ent(510, &[de(0), 1.0, 1.0, de(8)]));
+    ents.push(vector(116, c));
+    let mut sphere = ent(196, &[de(10), r]);
+    sphere.subordinate = 0; // marked independent: still drawn only as the face
+    ents.push(sphere);
+    let mut red = ent(510, &[de(11), 0.0, 0.0]);
+    red.colour = 2;
+    ents.push(red);
+    ents.push(ent(514, &[2.0, de(9), 1.0, de(12), 1.0]));
+    let mut solid = ent(186, &[de(13), 1.0, 0.0]);
+    solid.subordinate = 0;
+    solid.colour = 3;
+    solid.transform = 31;
+    ents.push(solid);
+    let shift = DVec3::new(1.0, 2.0, -3.0);
+    ents.push(ent(
+        124,
+        &[
+            1.0, 0.0, 0.0, shift.x, 0.0, 1.0, 0.0, shift.y, 0.0, 0.0, 1.0, shift.z,
+        ],
+    ));
+    let read = read(&ents);
+    assert!(read.report.failed.is_empty(), "{:?}", read.report.failed);
+    assert!(read.report.ignored.is_empty(), "{:?}", read.report.ignored);
+    assert_eq!(read.surfaces.len(), 2);
+    let (patch, ball) = (&read.surfaces[0], &read.surfaces[1]);
+    assert_eq!(patch.colour, Some(DVec3::Y));
+    assert_eq!(ball.colour, Some(DVec3::X));
+    let SurfaceGeometry::Nurbs(s) = &patch.surface.geometry else {
+        panic!()
+    };
+    for (u, v) in grid() {
+        close(s.eval(u, v), net_point(&n, u, v) + shift, 8.0, "186 face");
+    }
+    let [outer]: &[TrimLoop; 1] = patch.surface.trims.as_slice().try_into().unwrap();
+    assert!(!outer.hole);
+    for (k, seg) in outer.segments.iter().enumerate() {
+        let (a, b) = (DVec2::from(uv[k]), DVec2::from(uv[(k + 1) % 3]));
+        assert!((trim_point(&seg.curve, seg.t0) - a).length() < REL, "{k}");
+        assert!((trim_point(&seg.curve, seg.t1) - b).length() < REL, "{k}");
+    }
+    let SurfaceGeometry::Nurbs(b) = &ball.surface.geometry else {
+        panic!()
+    };
+    assert!(ball.surface.trims.is_empty());
+    for (u, v) in grid() {
+        let (u, v) = b.domain().to_parent(u, v);
+        let d = (b.eval(u, v) - c - shift).length();
+        assert!((d - r).abs() < 1e-12 * 8.0, "{d}");
+    }
+}
+
+#[test]
+fn subfigure_instances_become_transformed_copies() {
+    let (c, r) = (DVec3::new(0.5, -0.5, 1.0), 0.75);
+    // 0: 116; 1: 123; 2: 196 sphere; 3: 198 torus; 4: 308 {torus}; 5: 408 of 4 at
+    // (5, 0, 0); 6: 308 {sphere, 5}; 7: 408 of 6 at (1, 2, 3) scale 2; 8: 408 of 6
+    // at the origin.
+    let mut member = ent(196, &[de(0), r]);
+    member.subordinate = 0; // a member marked independent is still drawn only per instance
+    let mut outer = ent(408, &[de(6), 1.0, 2.0, 3.0, 2.0]);
+    outer.subordinate = 0;
+    let mut plain = ent(408, &[de(6)]);
+    plain.subordinate = 0;
+    let read = read(&[
+        vector(116, c),
+        vector(123, DVec3::Z),
+        member,
+        ent(198, &[de(0), de(1), 2.0, 0.5]),
+        ent(308, &[0.0, 0.0, 1.0, de(3)]),
+        ent(408, &[de(4), 5.0, 0.0, 0.0, 1.0]),
+        ent(308, &[1.0, 0.0, 2.0, de(2), de(5)]),
+        outer,
+        plain,
+    ]);
+    assert!(read.report.failed.is_empty(), "{:?}", read.report.failed);
+    assert_eq!(read.surfaces.len(), 4);
+    let place = |scale: f64, shift: DVec3, p: DVec3| shift + p * scale;
+    let t = DVec3::new(1.0, 2.0, 3.0);
+    let want: [(DVec3, f64, bool); 4] = [
+        (place(2.0, t, c), 2.0 * r, true),
+        (place(2.0, t, c + DVec3::X * 5.0), 2.0, false),
+        (c, r, true),
+        (c + DVec3::X * 5.0, 1.0, false),
+    ];
+    for (k, (drawn, (centre, scale, is_sphere))) in read.surfaces.iter().zip(want).enumerate() {
+        let SurfaceGeometry::Nurbs(s) = &drawn.surface.geometry else {
+            panic!()
+        };
+        for (u, v) in grid() {
+            let (u, v) = s.domain().to_parent(u, v);
+            let l = s.eval(u, v) - centre;
+            let residual = if is_sphere {
+                l.length() - scale
+            } else {
+                (l.truncate().length() - 2.0 * scale).hypot(l.z) - 0.5 * scale
+            };
+            assert!(residual.abs() < 1e-12 * 16.0, "copy {k}: {residual:e}");
+        }
+    }
+}
+
+#[test]
+fn subfigure_cycles_and_blow_ups_are_refused_by_name() {
+    // 0: 308 holding 1 twice; 1: 408 of 0 (a cycle); 2: 408 of 0, drawn.
+    let mut top = ent(408, &[de(0)]);
+    top.subordinate = 0;
+    let cyclic = read(&[
+        ent(308, &[0.0, 0.0, 2.0, de(1), de(1)]),
+        ent(408, &[de(0)]),
+        top,
+    ]);
+    assert!(cyclic.surfaces.is_empty());
+    assert!(
+        cyclic
+            .report
+            .failed
+            .iter()
+            .all(|f| f.ends_with("the definition D 1 contains an instance of itself")),
+        "{:?}",
+        cyclic.report.failed
+    );
+    // Ten definitions each instancing the next four times: 4^10 copies, cut off.
+    let mut ents = Vec::new();
+    for k in 0..10 {
+        ents.push(ent(
+            308,
+            &[
+                0.0,
+                0.0,
+                4.0,
+                de(2 * k + 1),
+                de(2 * k + 1),
+                de(2 * k + 1),
+                de(2 * k + 1),
+            ],
+        ));
+        ents.push(ent(408, &[de(2 * k + 2)]));
+    }
+    ents.push(ent(308, &[0.0, 0.0, 0.0]));
+    let mut top = ent(408, &[de(0)]);
+    top.subordinate = 0;
+    ents.push(top);
+    let blown = read(&ents);
+    assert!(
+        blown
+            .report
+            .failed
+            .iter()
+            .any(|f| f.contains("more than 65536 entities drawn through instances")),
+        "{:?}",
+        blown.report.failed.len()
+    );
+}

@@ -169,15 +169,16 @@ fn arc(z: f64, centre: DVec2, start: DVec2, end: DVec2) -> Result<Piece, String>
     ))
 }
 
-/// 104 (§4.5): an ellipse in general position (B² < 4AC) is brought to its centre and axes
-/// and converted exactly; a parabola must be in a standard position (A x² + E y = 0 or
-/// C y² + D x = 0). Hyperbolas are refused by name (not yet converted).
+/// 104 (§4.5): an ellipse or hyperbola in general position (B² ≠ 4AC) is brought to its
+/// centre and axes and converted exactly; a parabola must be in a standard position
+/// (A x² + E y = 0 or C y² + D x = 0).
 fn conic(k: &[f64; 6], z: f64, start: DVec2, end: DVec2) -> Result<Piece, String> {
     let [a, b, c, d, e, f] = *k;
     let disc = b * b - 4.0 * a * c;
     let err = |x: analytic::ShapeError| x.to_string();
-    if disc < 0.0 {
-        // Centre: the gradient vanishes. Axes: rotate by θ with tan 2θ = B / (A − C).
+    if disc != 0.0 {
+        // Centre: the gradient vanishes. Axes: rotate by θ with tan 2θ = B / (A − C); in
+        // the axes the conic is A' x'² + C' y'² + F' = 0.
         let det = 4.0 * a * c - b * b;
         let centre = DVec2::new((b * e - 2.0 * c * d) / det, (b * d - 2.0 * a * e) / det);
         let f0 = a * centre.x * centre.x
@@ -190,8 +191,12 @@ fn conic(k: &[f64; 6], z: f64, start: DVec2, end: DVec2) -> Result<Piece, String
         let (s, co) = theta.sin_cos();
         let a2 = a * co * co + b * co * s + c * s * s;
         let c2 = a * s * s - b * co * s + c * co * co;
+        let (e1, e2) = (DVec2::new(co, s), DVec2::new(-s, co));
+        if disc > 0.0 {
+            return hyperbola(centre, z, [(e1, a2), (e2, c2)], f0, start, end);
+        }
         let (ra, rb) = ((-f0 / a2).sqrt(), (-f0 / c2).sqrt());
-        let x = DVec3::new(co, s, 0.0);
+        let x = e1.extend(0.0);
         let frame = Frame {
             origin: centre.extend(z),
             x,
@@ -200,8 +205,7 @@ fn conic(k: &[f64; 6], z: f64, start: DVec2, end: DVec2) -> Result<Piece, String
         };
         let local = |p: DVec2| {
             let q = p - centre;
-            let (u, v) = (q.dot(DVec2::new(co, s)), q.dot(DVec2::new(-s, co)));
-            (v / rb).atan2(u / ra)
+            (q.dot(e2) / rb).atan2(q.dot(e1) / ra)
         };
         let t0 = local(start);
         let mut t1 = local(end);
@@ -213,7 +217,7 @@ fn conic(k: &[f64; 6], z: f64, start: DVec2, end: DVec2) -> Result<Piece, String
         ));
     }
     let frame = plane_frame(DVec3::new(0.0, 0.0, z));
-    if disc == 0.0 && b == 0.0 && f == 0.0 {
+    if b == 0.0 && f == 0.0 {
         if c == 0.0 && d == 0.0 && a != 0.0 && e != 0.0 {
             // y = −(A/E) x²: the parabola of `analytic` with its axes swapped.
             let fr = Frame {
@@ -234,7 +238,49 @@ fn conic(k: &[f64; 6], z: f64, start: DVec2, end: DVec2) -> Result<Piece, String
             ));
         }
     }
-    Err("conic arcs other than ellipses and parabolas in standard position (§4.5) are not supported yet".into())
+    Err("parabolic arcs other than in standard position (§4.5) are not supported yet".into())
+}
+
+/// The hyperbolic arc of a 104 in its axes `[(e1, A'), (e2, C')]` about `centre`, where
+/// A' x'² + C' y'² + F' = 0: the transverse axis is the one whose coefficient has the
+/// sign opposite to F'. In the frame (transverse axis towards the start's branch, the
+/// other axis oriented so the parameter increases from start to end) the arc is
+/// (a cosh t, b sinh t) with t = asinh(y / b), converted by `analytic::hyperbola_arc`.
+fn hyperbola(
+    centre: DVec2,
+    z: f64,
+    axes: [(DVec2, f64); 2],
+    f0: f64,
+    start: DVec2,
+    end: DVec2,
+) -> Result<Piece, String> {
+    let [(main, ka), (other, kb)] = if -f0 / axes[0].1 > 0.0 {
+        axes
+    } else {
+        [axes[1], axes[0]]
+    };
+    let (ra, rb) = ((-f0 / ka).sqrt(), (f0 / kb).sqrt());
+    if !(ra > 0.0 && rb > 0.0) {
+        return Err("a degenerate hyperbola (a pair of lines) is not a conic arc".into());
+    }
+    let (qs, qe) = (start - centre, end - centre);
+    let side = qs.dot(main).signum();
+    if qe.dot(main).signum() != side {
+        return Err("the start and end of a hyperbolic arc are on different branches".into());
+    }
+    let t = |q: DVec2| (q.dot(other) / rb).asinh();
+    let turn = if t(qs) <= t(qe) { 1.0 } else { -1.0 };
+    let (x, y) = ((main * side).extend(0.0), (other * turn).extend(0.0));
+    let frame = Frame {
+        origin: centre.extend(z),
+        x,
+        y,
+        z: x.cross(y),
+    };
+    let (t0, t1) = (turn * t(qs), turn * t(qe));
+    Ok(Piece::whole(
+        analytic::hyperbola_arc(&frame, ra, rb, [t0, t1]).map_err(|e| e.to_string())?,
+    ))
 }
 
 /// 106: the points joined in order, parameter i at point i.

@@ -137,6 +137,59 @@ pub struct BSplineSurface {
     pub range: [f64; 4],
 }
 
+/// The parametric spline surface of entity 114 (§4.15): bicubic polynomial patches on a
+/// grid of breakpoints; patch `i * n_v + j` spans `[u[i], u[i+1]] × [v[j], v[j+1]]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SplineSurface {
+    pub u: Vec<f64>,
+    pub v: Vec<f64>,
+    /// Per patch, per coordinate x, y, z, the 16 coefficients of s^a t^b at `a + 4 b`
+    /// (AX, BX, CX, DX, EX, … SX), s and t measured from the patch's lower breakpoints.
+    pub patches: Vec<[[f64; 16]; 3]>,
+}
+
+/// The shape of an IGES 5.3 analytic surface (190–198, §4.38–4.42).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Elementary {
+    Plane,
+    Cylinder {
+        radius: f64,
+    },
+    /// `radius` at the location; the semi-angle as written, in degrees.
+    Cone {
+        radius: f64,
+        semi_angle: f64,
+    },
+    Sphere {
+        radius: f64,
+    },
+    Torus {
+        major: f64,
+        minor: f64,
+    },
+}
+
+/// One model-space curve of a 141 boundary and its parameter-space curves.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BoundaryCurve {
+    pub model: usize,
+    /// SENSE 2: the curve runs against the boundary's direction.
+    pub reversed: bool,
+    pub parameter: Vec<usize>,
+}
+
+/// One entry of a 508 loop: an edge of a 504 edge list, or a vertex (then empty).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoopEdge {
+    /// The 504 and the 1-based index of the edge in it (0, 0 for a vertex entry).
+    pub list: usize,
+    pub index: usize,
+    /// OF 0: the edge runs against its curve's direction in the loop.
+    pub reversed: bool,
+    /// Its parameter-space curves on the face's surface.
+    pub parameter: Vec<usize>,
+}
+
 /// The supported entities. Pointers are directory sequence numbers (0 for none).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Entity {
@@ -192,6 +245,57 @@ pub enum Entity {
     },
     /// 122: tabulated cylinder of `directrix` to the generatrix end point.
     Tabulated { directrix: usize, end: DVec3 },
+    /// 114: parametric spline surface.
+    SplineSurface(SplineSurface),
+    /// 116: point.
+    Point(DVec3),
+    /// 123: direction.
+    Direction(DVec3),
+    /// 190–198: the analytic surface `shape` placed by the 116 `location` (centre), the
+    /// 123 `axis` (normal; 0 where form 0 of a sphere gives none) and, for form 1
+    /// (parameterised), the 123 `reference` direction (else 0).
+    Elementary {
+        shape: Elementary,
+        location: usize,
+        axis: usize,
+        reference: usize,
+    },
+    /// 141: boundary on `surface`; `model_preferred` is PREF 1 (model-space curves
+    /// preferred); TYPE 0 boundaries carry no parameter-space curves.
+    Boundary {
+        surface: usize,
+        model_preferred: bool,
+        curves: Vec<BoundaryCurve>,
+    },
+    /// 143: bounded surface: `surface` cut by the 141 `boundaries`.
+    Bounded {
+        surface: usize,
+        boundaries: Vec<usize>,
+    },
+    /// 186: manifold solid B-rep object: its outer shell and void shells (514s).
+    Brep { shells: Vec<usize> },
+    /// 308: subfigure definition: its member entities.
+    Subfigure(Vec<usize>),
+    /// 408: singular subfigure instance of the 308 `definition`, translated and scaled.
+    Instance {
+        definition: usize,
+        translation: DVec3,
+        scale: f64,
+    },
+    /// 504: edge list: the model-space curve of each edge (its vertices are not needed:
+    /// the curves run between them).
+    Edges(Vec<usize>),
+    /// 508: loop of edges.
+    Loop(Vec<LoopEdge>),
+    /// 510: face of `surface` bounded by its 508 `loops`; `outer_first`: OF 1, the first
+    /// loop is the outer one.
+    Face {
+        surface: usize,
+        outer_first: bool,
+        loops: Vec<usize>,
+    },
+    /// 514: shell: its 510 faces.
+    Shell(Vec<usize>),
     /// 142: curve on a parametric surface.
     CurveOnSurface {
         surface: usize,
@@ -221,15 +325,32 @@ pub fn is_supported(entity_type: i32) -> bool {
             | 108
             | 110
             | 112
+            | 114
+            | 116
             | 118
             | 120
             | 122
+            | 123
             | 124
             | 126
             | 128
+            | 141
             | 142
+            | 143
             | 144
+            | 186
+            | 190
+            | 192
+            | 194
+            | 196
+            | 198
+            | 308
             | 314
+            | 408
+            | 504
+            | 508
+            | 510
+            | 514
     )
 }
 
@@ -304,6 +425,36 @@ pub fn read(p: &Params<'_>) -> Result<Entity, ParseError> {
                 coefficients,
             }
         }
+        114 => {
+            let (m, n) = (p.count(3, MAX_COUNT)?, p.count(4, MAX_COUNT)?);
+            m.checked_mul(n)
+                .filter(|&c| (1..=MAX_COUNT).contains(&c))
+                .ok_or_else(|| p.error(3, "from 1 to 2^24 patches"))?;
+            let (u_at, v_at) = (5, 6 + m);
+            // After each row of n patches, and after the last row, the standard stores
+            // 48 arbitrary values per patch position (one more patch per row, one more
+            // row); they carry nothing and are skipped, and may be missing at the end.
+            let patch_at = |i: usize, j: usize| 7 + m + n + 48 * (i * (n + 1) + j);
+            p.need(patch_at(m - 1, n - 1) + 47)?;
+            let patches = (0..m)
+                .flat_map(|i| (0..n).map(move |j| (i, j)))
+                .map(|(i, j)| {
+                    let c = p.reals(patch_at(i, j), 48)?;
+                    Ok([0, 1, 2].map(|d| {
+                        let mut k = [0.0; 16];
+                        k.copy_from_slice(&c[16 * d..16 * d + 16]);
+                        k
+                    }))
+                })
+                .collect::<Result<_, ParseError>>()?;
+            Entity::SplineSurface(SplineSurface {
+                u: p.reals(u_at, m + 1)?,
+                v: p.reals(v_at, n + 1)?,
+                patches,
+            })
+        }
+        116 => Entity::Point(p.point(1)?),
+        123 => Entity::Direction(p.point(1)?),
         118 => Entity::Ruled {
             curves: [p.pointer(1)?, p.pointer(2)?],
             reversed: p.int(3)? == 1,
@@ -384,6 +535,36 @@ pub fn read(p: &Params<'_>) -> Result<Entity, ParseError> {
                 ],
             })
         }
+        141 => {
+            let n = p.count(4, MAX_COUNT)?;
+            let mut curves = Vec::with_capacity(n.min(1024));
+            let mut at = 5;
+            for _ in 0..n {
+                let k = p.count(at + 2, MAX_COUNT)?;
+                p.need(at + 2 + k)?;
+                curves.push(BoundaryCurve {
+                    model: p.pointer(at)?,
+                    reversed: p.int(at + 1)? == 2,
+                    parameter: (at + 3..at + 3 + k)
+                        .map(|i| p.pointer(i))
+                        .collect::<Result<_, _>>()?,
+                });
+                at += 3 + k;
+            }
+            Entity::Boundary {
+                surface: p.pointer(3)?,
+                model_preferred: p.int(2)? == 1,
+                curves,
+            }
+        }
+        143 => {
+            let n = p.count(3, MAX_COUNT)?;
+            p.need(3 + n)?;
+            Entity::Bounded {
+                surface: p.pointer(2)?,
+                boundaries: (4..4 + n).map(|i| p.pointer(i)).collect::<Result<_, _>>()?,
+            }
+        }
         142 => Entity::CurveOnSurface {
             surface: p.pointer(2)?,
             parameter_curve: p.pointer(3)?,
@@ -402,6 +583,117 @@ pub fn read(p: &Params<'_>) -> Result<Entity, ParseError> {
                     .map(|i| p.pointer(i))
                     .collect::<Result<_, _>>()?,
             }
+        }
+        190 => Entity::Elementary {
+            shape: Elementary::Plane,
+            location: p.pointer(1)?,
+            axis: p.pointer(2)?,
+            reference: if form == 1 { p.pointer(3)? } else { 0 },
+        },
+        192 => Entity::Elementary {
+            shape: Elementary::Cylinder { radius: p.real(3)? },
+            location: p.pointer(1)?,
+            axis: p.pointer(2)?,
+            reference: if form == 1 { p.pointer(4)? } else { 0 },
+        },
+        194 => Entity::Elementary {
+            shape: Elementary::Cone {
+                radius: p.real(3)?,
+                semi_angle: p.real(4)?,
+            },
+            location: p.pointer(1)?,
+            axis: p.pointer(2)?,
+            reference: if form == 1 { p.pointer(5)? } else { 0 },
+        },
+        196 => Entity::Elementary {
+            shape: Elementary::Sphere { radius: p.real(2)? },
+            location: p.pointer(1)?,
+            axis: if form == 1 { p.pointer(3)? } else { 0 },
+            reference: if form == 1 { p.pointer(4)? } else { 0 },
+        },
+        198 => Entity::Elementary {
+            shape: Elementary::Torus {
+                major: p.real(3)?,
+                minor: p.real(4)?,
+            },
+            location: p.pointer(1)?,
+            axis: p.pointer(2)?,
+            reference: if form == 1 { p.pointer(5)? } else { 0 },
+        },
+        186 => {
+            // SHELL, SOF, N, then N × (VOID, VOF); orientation flags do not matter to
+            // the even–odd trims of each face.
+            let n = p.count(3, MAX_COUNT)?;
+            p.need(3 + 2 * n)?;
+            let mut shells = vec![p.pointer(1)?];
+            for k in 0..n {
+                shells.push(p.pointer(4 + 2 * k)?);
+            }
+            Entity::Brep { shells }
+        }
+        308 => {
+            // DEPTH, NAME, N, then N pointers.
+            let n = p.count(3, MAX_COUNT)?;
+            p.need(3 + n)?;
+            Entity::Subfigure((4..4 + n).map(|i| p.pointer(i)).collect::<Result<_, _>>()?)
+        }
+        408 => Entity::Instance {
+            definition: p.pointer(1)?,
+            translation: DVec3::new(p.real_or(2, 0.0)?, p.real_or(3, 0.0)?, p.real_or(4, 0.0)?),
+            scale: p.real_or(5, 1.0)?,
+        },
+        504 => {
+            // N, then N × (CURV, SVP, SV, TVP, TV).
+            let n = p.count(1, MAX_COUNT)?;
+            p.need(1 + 5 * n)?;
+            Entity::Edges(
+                (0..n)
+                    .map(|k| p.pointer(2 + 5 * k))
+                    .collect::<Result<_, _>>()?,
+            )
+        }
+        508 => {
+            // N, then per entry TYPE, EDGE, NDX, OF, K and K × (ISOP, CURV).
+            let n = p.count(1, MAX_COUNT)?;
+            let mut edges = Vec::with_capacity(n.min(1024));
+            let mut at = 2;
+            for _ in 0..n {
+                let k = p.count(at + 4, MAX_COUNT)?;
+                p.need(at + 4 + 2 * k)?;
+                let vertex = p.int(at)? == 1;
+                edges.push(LoopEdge {
+                    list: if vertex { 0 } else { p.pointer(at + 1)? },
+                    index: if vertex {
+                        0
+                    } else {
+                        p.count(at + 2, MAX_COUNT)?
+                    },
+                    reversed: p.int(at + 3)? == 0,
+                    parameter: (0..k)
+                        .map(|j| p.pointer(at + 6 + 2 * j))
+                        .collect::<Result<_, _>>()?,
+                });
+                at += 5 + 2 * k;
+            }
+            Entity::Loop(edges)
+        }
+        510 => {
+            let n = p.count(2, MAX_COUNT)?;
+            p.need(3 + n)?;
+            Entity::Face {
+                surface: p.pointer(1)?,
+                outer_first: p.int(3)? == 1,
+                loops: (4..4 + n).map(|i| p.pointer(i)).collect::<Result<_, _>>()?,
+            }
+        }
+        514 => {
+            let n = p.count(1, MAX_COUNT)?;
+            p.need(1 + 2 * n)?;
+            Entity::Shell(
+                (0..n)
+                    .map(|k| p.pointer(2 + 2 * k))
+                    .collect::<Result<_, _>>()?,
+            )
         }
         314 => Entity::Colour(DVec3::new(p.real(1)?, p.real(2)?, p.real(3)?)),
         _ => Entity::Unsupported,

@@ -6,12 +6,17 @@
 //! (144 over any surface, 142 curves on surfaces).
 //!
 //! Drawn are the visible entities that are not physically part of others (§2.3.1 status):
-//! trimmed surfaces (144) and bare surfaces (128, 108, 118, 120, 122). What is not read
+//! trimmed surfaces (144), bounded surfaces (143), the faces of manifold solids (186, its
+//! 514 shells, 510 faces, 508 loops and 504 edge lists), bare surfaces (128, 114, 108,
+//! 118, 120, 122, and the closed analytic 196, 198), and subfigure instances (408 of a
+//! 308), flattened into transformed copies of their members while the scene model has no
+//! shared instances. What is not read
 //! is counted by type in [`Report`]; a surface that cannot be converted is named by its
 //! directory sequence number; neither is dropped silently.
 
 pub mod curves;
 pub mod directory;
+pub mod elementary;
 pub mod entities;
 pub mod records;
 pub mod surfaces;
@@ -287,45 +292,186 @@ pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
     }
     let model = Model { entries, entities };
     // Some writers leave the surface under a 144 marked independent; it is drawn through
-    // the 144 only (drawn again, its untrimmed whole would cover the trims).
-    let trimmed: std::collections::HashSet<usize> = model
-        .entities
-        .iter()
-        .filter_map(|e| match e {
-            Entity::Trimmed { surface, .. } => Some(*surface),
-            _ => None,
-        })
-        .collect();
-    let mut surfaces = Vec::new();
-    for (entry, entity) in model.entries.iter().zip(&model.entities) {
-        if !entry.is_drawn() || trimmed.contains(&entry.sequence) {
-            continue;
-        }
-        let converted = match entity {
-            Entity::Trimmed { .. } => trimmed::trimmed(&model, entry.sequence, &mut report),
-            Entity::BSplineSurface(_)
-            | Entity::Plane { .. }
-            | Entity::Ruled { .. }
-            | Entity::Revolution { .. }
-            | Entity::Tabulated { .. } => trimmed::untrimmed(&model, entry.sequence),
-            Entity::Transform(_) | Entity::Colour(_) => continue,
-            _ => {
-                *report.ignored.entry(entry.entity_type).or_default() += 1;
-                continue;
+    // the 144 only (drawn again, its untrimmed whole would cover the trims). Members of
+    // subfigure definitions are drawn through their instances only.
+    let mut through_others = std::collections::HashSet::new();
+    for e in &model.entities {
+        match e {
+            Entity::Trimmed { surface, .. }
+            | Entity::Bounded { surface, .. }
+            | Entity::Face { surface, .. } => {
+                through_others.insert(*surface);
             }
-        };
-        match converted {
-            Ok(surface) => surfaces.push(Drawn {
-                surface,
-                colour: model.colour(entry),
-            }),
-            Err(why) => report.failed.push(format!(
-                "entity {} (D {}): {why}",
-                entry.entity_type, entry.sequence
-            )),
+            Entity::Subfigure(members) => through_others.extend(members.iter().copied()),
+            _ => {}
         }
     }
+    let mut surfaces = Vec::new();
+    for entry in &model.entries {
+        if !entry.is_drawn() || through_others.contains(&entry.sequence) {
+            continue;
+        }
+        draw(
+            &model,
+            entry.sequence,
+            &DAffine3::IDENTITY,
+            &mut Instancing::default(),
+            &mut report,
+            &mut surfaces,
+        );
+    }
     Ok(Iges { surfaces, report })
+}
+
+/// Entities drawn through the instances of one top-level 408 at most: definitions that
+/// instance each other several times multiply, and a hostile file must not turn a few
+/// lines into billions of surfaces.
+const MAX_INSTANCE_COPIES: usize = 1 << 16;
+
+/// The subfigure definitions being expanded (a definition inside itself is a cycle) and
+/// the copies still allowed.
+struct Instancing {
+    definitions: Vec<usize>,
+    copies_left: usize,
+}
+
+impl Default for Instancing {
+    fn default() -> Self {
+        Instancing {
+            definitions: Vec::new(),
+            copies_left: MAX_INSTANCE_COPIES,
+        }
+    }
+}
+
+/// Converts the drawn entity at `pointer` into `out`, every surface mapped by `m` (the
+/// transforms of the instances it is drawn through). Failures are reported by entity.
+fn draw(
+    model: &Model,
+    pointer: usize,
+    m: &DAffine3,
+    instancing: &mut Instancing,
+    report: &mut Report,
+    out: &mut Vec<Drawn>,
+) {
+    let Ok((entry, entity)) = model.get(pointer) else {
+        report
+            .failed
+            .push(format!("D {pointer}: not a directory entry of this file"));
+        return;
+    };
+    let colour = model.colour(entry);
+    let fail = |report: &mut Report, why: String| {
+        report.failed.push(format!(
+            "entity {} (D {}): {why}",
+            entry.entity_type, entry.sequence
+        ))
+    };
+    let converted = match entity {
+        Entity::Trimmed { .. } => trimmed::trimmed(model, pointer, report),
+        Entity::Bounded { .. } => trimmed::bounded(model, pointer, report),
+        Entity::BSplineSurface(_)
+        | Entity::SplineSurface(_)
+        | Entity::Elementary { .. }
+        | Entity::Plane { .. }
+        | Entity::Ruled { .. }
+        | Entity::Revolution { .. }
+        | Entity::Tabulated { .. } => trimmed::untrimmed(model, pointer, report),
+        Entity::Brep { shells } => {
+            // §4.2 (186): every face of the outer and void shells, each its own trimmed
+            // surface, in the solid's colour unless the face has its own.
+            let solid = match model.transform(entry.transform) {
+                Ok(t) => *m * t,
+                Err(why) => return fail(report, why),
+            };
+            for &shell in shells {
+                let faces = match model.get(shell) {
+                    Ok((_, Entity::Shell(faces))) => faces,
+                    Ok(_) => {
+                        return fail(report, format!("the shell D {shell} is not a shell (514)"));
+                    }
+                    Err(why) => return fail(report, why),
+                };
+                for &f in faces {
+                    let face_colour = model.get(f).ok().and_then(|(e, _)| model.colour(e));
+                    match trimmed::face(model, f, report) {
+                        Ok(mut surface) => {
+                            surface.transform(&solid);
+                            out.push(Drawn {
+                                surface,
+                                colour: face_colour.or(colour),
+                            });
+                        }
+                        Err(why) => report.failed.push(format!("entity 510 (D {f}): {why}")),
+                    }
+                }
+            }
+            return;
+        }
+        Entity::Instance {
+            definition,
+            translation,
+            scale,
+        } => {
+            // §4.137 (408): the definition scaled by S, translated by (X, Y, Z), then
+            // mapped by the instance's own transform. The renderer has no shared
+            // instances yet, so each instance becomes transformed copies of the members.
+            if instancing.definitions.contains(definition) {
+                return fail(
+                    report,
+                    format!("the definition D {definition} contains an instance of itself"),
+                );
+            }
+            let own = match model.transform(entry.transform) {
+                Ok(t) => t,
+                Err(why) => return fail(report, why),
+            };
+            let placed = *m
+                * own
+                * DAffine3::from_translation(*translation)
+                * DAffine3::from_scale(DVec3::splat(*scale));
+            match model.get(*definition) {
+                Ok((_, Entity::Subfigure(members))) => {
+                    instancing.definitions.push(*definition);
+                    for &member in members {
+                        if instancing.copies_left == 0 {
+                            fail(
+                                report,
+                                format!(
+                                    "more than {MAX_INSTANCE_COPIES} entities drawn through instances"
+                                ),
+                            );
+                            break;
+                        }
+                        instancing.copies_left -= 1;
+                        draw(model, member, &placed, instancing, report, out);
+                    }
+                    instancing.definitions.pop();
+                }
+                Ok(_) => fail(
+                    report,
+                    format!("the definition D {definition} is not a subfigure definition (308)"),
+                ),
+                Err(why) => fail(report, why),
+            }
+            return;
+        }
+        // Definitions are drawn through their instances; these are not drawn.
+        Entity::Subfigure(_) | Entity::Transform(_) | Entity::Colour(_) => return,
+        _ => {
+            *report.ignored.entry(entry.entity_type).or_default() += 1;
+            return;
+        }
+    };
+    match converted {
+        Ok(mut surface) => {
+            if *m != DAffine3::IDENTITY {
+                surface.transform(m);
+            }
+            out.push(Drawn { surface, colour });
+        }
+        Err(why) => fail(report, why),
+    }
 }
 
 /// Reads an IGES file from disk.

@@ -1,14 +1,14 @@
 //! Surface entities as exact rational NURBS (OpenCASCADE's `IGESToBRep_BasicSurface`),
 //! each in the parameterisation the standard gives, so that parameter-space trim curves
-//! land right: 128 rational B-spline surface, 118 ruled surface, 120 surface of revolution,
-//! 122 tabulated cylinder. Planes (108) have no parameterisation and are built around
+//! land right: 128 rational B-spline surface, 114 parametric spline surface, 118 ruled
+//! surface, 120 surface of revolution, 122 tabulated cylinder. Planes (108) have no parameterisation and are built around
 //! their boundaries in `trimmed`.
 
 use glam::DVec4;
 
 use super::Model;
 use super::curves::{self, Piece};
-use super::entities::Entity;
+use super::entities::{Entity, SplineSurface};
 use crate::geom::nurbs::analytic;
 use crate::geom::nurbs::{NurbsCurve, NurbsSurface};
 use crate::geom::trim::AxisMap;
@@ -61,6 +61,12 @@ pub fn surface(model: &Model, pointer: usize) -> Result<Converted, String> {
                 to_trim: SAME,
             }
         }
+        Entity::SplineSurface(spline) => Converted {
+            surface: bicubic(spline)?,
+            maps: Default::default(),
+            range: None,
+            to_trim: SAME,
+        },
         Entity::Ruled {
             curves: [a, b],
             reversed,
@@ -132,6 +138,65 @@ pub fn surface(model: &Model, pointer: usize) -> Result<Converted, String> {
     Ok(c)
 }
 
+/// 114 (§4.15): each patch's bicubic polynomial in (s, t), measured from its lower
+/// breakpoints, becomes its Bézier net exactly (s scaled to [0, 1] by powers of the patch
+/// width, then the power-to-Bernstein change of basis b_k = Σ_{a ≤ k} C(k, a) / C(3, a) c_a
+/// in each direction); the nets join into one bicubic B-spline with triple knots at the
+/// breakpoints, so the NURBS parameters are the entity's. Neighbouring patches share
+/// their boundary row of control points, which is taken from the later patch (the two
+/// agree to the file's rounding on a valid surface).
+fn bicubic(s: &SplineSurface) -> Result<NurbsSurface, String> {
+    let (m, n) = (s.u.len() - 1, s.v.len() - 1);
+    let increasing = |b: &[f64]| {
+        b.windows(2)
+            .all(|w| w[1].partial_cmp(&w[0]) == Some(std::cmp::Ordering::Greater))
+    };
+    if !increasing(&s.u) || !increasing(&s.v) {
+        return Err("the breakpoints of a parametric spline surface must increase".into());
+    }
+    // C(k, a) / C(3, a) for a ≤ k ≤ 3.
+    const TO_BERNSTEIN: [[f64; 4]; 4] = [
+        [1.0, 0.0, 0.0, 0.0],
+        [1.0, 1.0 / 3.0, 0.0, 0.0],
+        [1.0, 2.0 / 3.0, 1.0 / 3.0, 0.0],
+        [1.0, 1.0, 1.0, 1.0],
+    ];
+    let (count_u, count_v) = (3 * m + 1, 3 * n + 1);
+    let mut points = vec![DVec4::ZERO; count_u * count_v];
+    for i in 0..m {
+        let hu = s.u[i + 1] - s.u[i];
+        for j in 0..n {
+            let hv = s.v[j + 1] - s.v[j];
+            let patch = &s.patches[i * n + j];
+            for k in 0..4 {
+                for l in 0..4 {
+                    let mut p = [0.0; 3];
+                    for (d, c) in patch.iter().enumerate() {
+                        for a in 0..=k {
+                            for b in 0..=l {
+                                p[d] += TO_BERNSTEIN[k][a]
+                                    * TO_BERNSTEIN[l][b]
+                                    * c[a + 4 * b]
+                                    * hu.powi(a as i32)
+                                    * hv.powi(b as i32);
+                            }
+                        }
+                    }
+                    points[(3 * j + l) * count_u + 3 * i + k] = DVec4::new(p[0], p[1], p[2], 1.0);
+                }
+            }
+        }
+    }
+    let knots = |b: &[f64]| {
+        let mut k = vec![b[0]; 4];
+        for (x, &t) in b.iter().enumerate().skip(1) {
+            k.extend(std::iter::repeat_n(t, if x + 1 == b.len() { 4 } else { 3 }));
+        }
+        k
+    };
+    NurbsSurface::new(3, 3, knots(&s.u), knots(&s.v), count_u, count_v, points).map_err(err)
+}
+
 /// The one piece of a curve that must be a single NURBS curve (a generatrix, directrix or
 /// rail).
 fn single(mut pieces: Vec<Piece>) -> Result<Piece, String> {
@@ -145,7 +210,7 @@ fn single(mut pieces: Vec<Piece>) -> Result<Piece, String> {
 }
 
 /// The same curve run backwards: knots reflected, points reversed.
-fn reverse(p: &Piece) -> Piece {
+pub fn reverse(p: &Piece) -> Piece {
     let (a, b) = (p.curve.knots[0], p.curve.knots[p.curve.knots.len() - 1]);
     let mut points: Vec<DVec4> = p.curve.points.clone();
     points.reverse();

@@ -1,15 +1,18 @@
 //! Trimmed surfaces (OpenCASCADE's `IGESToBRep_TopoSurface`): 144 (a surface, an optional
-//! outer boundary and holes, each a 142 curve on the surface), and bare surfaces. A 142's
-//! parameter-space curve is used where it is given and not marked second choice (PREF 2);
-//! otherwise its model-space curve is projected into the domain by point inversion and the
-//! largest distance reported. Planes (108) have no parameterisation in IGES: their patch is
-//! laid in a frame of the plane around the boundary curves, projected onto it exactly
-//! (an affine map of the control points).
+//! outer boundary and holes, each a 142 curve on the surface), 143 (a surface and its 141
+//! boundaries, each a chain of model-space curves with their parameter-space curves), and
+//! bare surfaces. A parameter-space curve is used where it is given and not marked second
+//! choice; otherwise the model-space curve is projected into the domain (by point inversion
+//! on B-spline-like surfaces, reporting the largest distance; in closed form on the
+//! analytic 190–198). Planes (108, and 190 without parameterisation) have no
+//! parameterisation of their own: their patch is laid in a frame of the plane around the
+//! boundary curves, projected onto it exactly (an affine map of the control points).
 
 use glam::{DVec2, DVec3, DVec4};
 
 use super::curves::{self, Piece};
-use super::entities::Entity;
+use super::elementary::{self, Placed};
+use super::entities::{Elementary, Entity};
 use super::surfaces::{self, Converted};
 use super::{Model, Report};
 use crate::geom::nurbs::analytic::{self, Frame};
@@ -21,21 +24,46 @@ use crate::scene::model::{Surface, SurfaceGeometry};
 /// through them is a polyline (the projection has no exact form).
 const PROJECTED_PER_SEGMENT: usize = 24;
 
-/// A bare surface entity (no trims but a narrower 128 range).
-pub fn untrimmed(model: &Model, pointer: usize) -> Result<Surface, String> {
-    let (entry, entity) = model.get(pointer)?;
-    if let Entity::Plane { boundary, .. } = entity {
-        if *boundary == 0 {
-            return Err("an unbounded plane (108 form 0) has no extent to draw".into());
+/// One curve of a boundary: a model-space curve and the parameter-space curves that
+/// represent it (either may be absent: 0 and empty).
+struct Edge {
+    model: usize,
+    parameter: Vec<usize>,
+    /// Runs against the boundary's direction (141 SENSE 2).
+    reversed: bool,
+}
+
+/// A closed boundary of a surface, from a 142 or a 141.
+struct Boundary {
+    hole: bool,
+    model_preferred: bool,
+    edges: Vec<Edge>,
+}
+
+/// A bare surface entity (no trims but a narrower 128 range, or the whole of a closed
+/// analytic surface).
+pub fn untrimmed(model: &Model, pointer: usize, report: &mut Report) -> Result<Surface, String> {
+    let (_, entity) = model.get(pointer)?;
+    match entity {
+        Entity::Plane { boundary, .. } => {
+            if *boundary == 0 {
+                return Err("an unbounded plane (108 form 0) has no extent to draw".into());
+            }
+            // The 108's boundary is a model-space curve in the plane's definition space.
+            let edge = Edge {
+                model: *boundary,
+                parameter: Vec::new(),
+                reversed: false,
+            };
+            let loops = vec![Boundary {
+                hole: false,
+                model_preferred: true,
+                edges: vec![edge],
+            }];
+            with_loops(model, pointer, &loops, report, true)
         }
-        let m = model.transform(entry.transform)?;
-        let mut pieces = curves::pieces(model, *boundary)?;
-        for p in &mut pieces {
-            transform(&mut p.curve.points, &m);
-        }
-        return plane(model, pointer, vec![(false, pieces)]);
+        _ => with_loops(model, pointer, &[], report, false),
     }
-    Ok(finish(surfaces::surface(model, pointer)?, Vec::new()))
 }
 
 /// A 144 trimmed surface.
@@ -49,30 +77,408 @@ pub fn trimmed(model: &Model, pointer: usize, report: &mut Report) -> Result<Sur
     else {
         return Err("not a 144".into());
     };
-    let m = model.transform(entry.transform)?;
-    let boundaries: Vec<(bool, usize)> = outer
+    let loops = outer
         .iter()
-        .map(|&o| (false, o))
-        .chain(holes.iter().map(|&h| (true, h)))
-        .collect();
-    let mut s = if let Entity::Plane { .. } = model.get(*surface)?.1 {
-        let loops = boundaries
-            .iter()
-            .map(|&(hole, b)| Ok((hole, model_curve(model, b)?)))
-            .collect::<Result<Vec<_>, String>>()?;
-        plane(model, *surface, loops)?
-    } else {
-        let c = surfaces::surface(model, *surface)?;
-        let mut inverter = None;
-        let mut loops = Vec::new();
-        for &(hole, b) in &boundaries {
-            let segments = boundary(model, b, &c, &mut inverter, report)?;
-            loops.push(TrimLoop { hole, segments });
-        }
-        finish(c, loops)
-    };
-    s.transform(&m);
+        .map(|&o| curve_on_surface(model, o, false))
+        .chain(holes.iter().map(|&h| curve_on_surface(model, h, true)))
+        .collect::<Result<Vec<_>, String>>()?;
+    let mut s = with_loops(model, *surface, &loops, report, false)?;
+    s.transform(&model.transform(entry.transform)?);
     Ok(s)
+}
+
+/// A 143 bounded surface. The standard does not say which boundary is outer; the first is
+/// taken as the outer one, which matters only when there is one loop (the even–odd rule
+/// sorts out nesting whatever the flags).
+pub fn bounded(model: &Model, pointer: usize, report: &mut Report) -> Result<Surface, String> {
+    let (entry, entity) = model.get(pointer)?;
+    let Entity::Bounded {
+        surface,
+        boundaries,
+    } = entity
+    else {
+        return Err("not a 143".into());
+    };
+    if boundaries.is_empty() {
+        return Err("a bounded surface (143) without boundaries".into());
+    }
+    let loops = boundaries
+        .iter()
+        .enumerate()
+        .map(|(k, &b)| boundary_entity(model, b, k > 0))
+        .collect::<Result<Vec<_>, String>>()?;
+    let mut s = with_loops(model, *surface, &loops, report, false)?;
+    s.transform(&model.transform(entry.transform)?);
+    Ok(s)
+}
+
+/// A 510 face of a 186 solid: its surface cut by its 508 loops, whose edges are the
+/// model-space curves of 504 edge lists with their parameter-space curves (used where
+/// given). Without OF 1 no loop is outer, and the domain's boundary is.
+pub fn face(model: &Model, pointer: usize, report: &mut Report) -> Result<Surface, String> {
+    let Entity::Face {
+        surface,
+        outer_first,
+        loops,
+    } = model.get(pointer)?.1
+    else {
+        return Err(format!("D {pointer} is not a face (510)"));
+    };
+    let mut boundaries = Vec::new();
+    for (k, &l) in loops.iter().enumerate() {
+        let Entity::Loop(entries) = model.get(l)?.1 else {
+            return Err(format!("the loop D {l} is not a loop (508)"));
+        };
+        let mut edges = Vec::new();
+        // Vertex entries (list 0) bound nothing.
+        for e in entries.iter().filter(|e| e.list != 0) {
+            let Entity::Edges(curves) = model.get(e.list)?.1 else {
+                return Err(format!(
+                    "the edge list D {} is not an edge list (504)",
+                    e.list
+                ));
+            };
+            let curve = *e
+                .index
+                .checked_sub(1)
+                .and_then(|i| curves.get(i))
+                .ok_or_else(|| {
+                    format!(
+                        "edge {} of the edge list D {} does not exist",
+                        e.index, e.list
+                    )
+                })?;
+            edges.push(Edge {
+                model: curve,
+                parameter: e.parameter.clone(),
+                reversed: e.reversed,
+            });
+        }
+        boundaries.push(Boundary {
+            hole: !(*outer_first && k == 0),
+            model_preferred: false,
+            edges,
+        });
+    }
+    with_loops(model, *surface, &boundaries, report, false)
+}
+
+/// A 142 as a boundary.
+fn curve_on_surface(model: &Model, pointer: usize, hole: bool) -> Result<Boundary, String> {
+    let Entity::CurveOnSurface {
+        parameter_curve,
+        model_curve,
+        preferred,
+        ..
+    } = model.get(pointer)?.1
+    else {
+        return Err(format!(
+            "the boundary D {pointer} is not a curve on a surface (142)"
+        ));
+    };
+    Ok(Boundary {
+        hole,
+        // PREF 2: the model-space curve C is preferred (§4.22).
+        model_preferred: *preferred == 2,
+        edges: vec![Edge {
+            model: *model_curve,
+            parameter: (*parameter_curve != 0)
+                .then_some(*parameter_curve)
+                .into_iter()
+                .collect(),
+            reversed: false,
+        }],
+    })
+}
+
+/// A 141 as a boundary.
+fn boundary_entity(model: &Model, pointer: usize, hole: bool) -> Result<Boundary, String> {
+    let Entity::Boundary {
+        model_preferred,
+        curves,
+        ..
+    } = model.get(pointer)?.1
+    else {
+        return Err(format!("the boundary D {pointer} is not a boundary (141)"));
+    };
+    Ok(Boundary {
+        hole,
+        model_preferred: *model_preferred,
+        edges: curves
+            .iter()
+            .map(|c| Edge {
+                model: c.model,
+                parameter: c.parameter.clone(),
+                reversed: c.reversed,
+            })
+            .collect(),
+    })
+}
+
+/// The surface entity at `pointer` with the given boundaries as its trim loops. `in_plane`:
+/// the boundaries are in the surface's own definition space (a 108's bounding curve)
+/// rather than in the model space the surface's transform maps into.
+fn with_loops(
+    model: &Model,
+    pointer: usize,
+    loops: &[Boundary],
+    report: &mut Report,
+    in_plane: bool,
+) -> Result<Surface, String> {
+    let (entry, entity) = model.get(pointer)?;
+    if let Entity::Plane { coefficients, .. } = entity {
+        // The frame: normal (A, B, C), origin the plane's point nearest the definition
+        // origin, in model space.
+        let [a, b, c, d] = *coefficients;
+        let n = DVec3::new(a, b, c);
+        let m = model.transform(entry.transform)?;
+        let origin = m.transform_point3(n * (d / n.length_squared()));
+        let frame = Frame::new(origin, m.transform_vector3(n), None).map_err(err)?;
+        let mut trims = Vec::new();
+        for l in loops {
+            let mut segments = Vec::new();
+            for e in &l.edges {
+                for mut p in edge_pieces(model, e.model, e.reversed)? {
+                    if in_plane {
+                        transform(&mut p.curve.points, &m);
+                    }
+                    segments.push(in_frame(&frame, p));
+                }
+            }
+            trims.push(TrimLoop {
+                hole: l.hole,
+                segments,
+            });
+        }
+        return planar(&frame, trims);
+    }
+    if let Some(placed) = elementary::placed(model, pointer)? {
+        return analytic_with_loops(model, &placed, loops);
+    }
+    let c = surfaces::surface(model, pointer)?;
+    let mut inverter = None;
+    let mut trims = Vec::new();
+    for l in loops {
+        let mut segments = Vec::new();
+        for e in &l.edges {
+            if let Some(s) = parameter_segments(model, l.model_preferred, e, c.to_trim)? {
+                segments.extend(s);
+                continue;
+            }
+            let inv = inverter.get_or_insert_with(|| Inverter::new(&c.surface));
+            for piece in edge_pieces(model, e.model, e.reversed)? {
+                let mut points = Vec::new();
+                for q in samples(&piece) {
+                    let hit = inv
+                        .project(q)
+                        .ok_or("a model-space trim point could not be projected")?;
+                    report.max_projection_error = report.max_projection_error.max(hit.distance);
+                    points.push(DVec2::new(c.maps[0].apply(hit.u), c.maps[1].apply(hit.v)));
+                }
+                if points.len() >= 2 {
+                    segments.push(TrimSegment::polyline(&points));
+                }
+            }
+            report.projected += 1;
+        }
+        trims.push(TrimLoop {
+            hole: l.hole,
+            segments,
+        });
+    }
+    Ok(finish(c, trims))
+}
+
+fn err(e: impl std::fmt::Display) -> String {
+    e.to_string()
+}
+
+/// The parameter-space curves of an edge as trim segments (the affine `to_trim` applied,
+/// exact on the homogeneous points), or `None` where the model-space curve is to be used:
+/// there are none, or the model-space curve is preferred and present.
+fn parameter_segments(
+    model: &Model,
+    model_preferred: bool,
+    e: &Edge,
+    [(su, ou), (sv, ov)]: [(f64, f64); 2],
+) -> Result<Option<Vec<TrimSegment>>, String> {
+    if e.parameter.is_empty() || (model_preferred && e.model != 0) {
+        if e.model == 0 {
+            return Err(
+                "a boundary curve has neither a parameter-space nor a model-space curve".into(),
+            );
+        }
+        return Ok(None);
+    }
+    let mut out = Vec::new();
+    for &pc in &e.parameter {
+        for p in oriented(curves::pieces(model, pc)?, e.reversed) {
+            out.push(TrimSegment {
+                t0: p.t0,
+                t1: p.t1,
+                curve: ParamCurve {
+                    degree: p.curve.degree,
+                    knots: p.curve.knots,
+                    points: p
+                        .curve
+                        .points
+                        .iter()
+                        .map(|q| DVec3::new(su * q.x + ou * q.w, sv * q.y + ov * q.w, q.w))
+                        .collect(),
+                },
+            });
+        }
+    }
+    if e.reversed {
+        out.reverse();
+    }
+    Ok(Some(out))
+}
+
+/// The pieces of a model-space curve, run backwards where the edge is reversed.
+fn edge_pieces(model: &Model, pointer: usize, reversed: bool) -> Result<Vec<Piece>, String> {
+    if pointer == 0 {
+        return Err("a boundary curve of a plane has no model-space curve".into());
+    }
+    let mut pieces = oriented(curves::pieces(model, pointer)?, reversed);
+    if reversed {
+        pieces.reverse();
+    }
+    Ok(pieces)
+}
+
+fn oriented(pieces: Vec<Piece>, reversed: bool) -> Vec<Piece> {
+    if reversed {
+        pieces.iter().map(surfaces::reverse).collect()
+    } else {
+        pieces
+    }
+}
+
+/// Points along a model-space curve piece, `PROJECTED_PER_SEGMENT` per Bézier segment.
+fn samples(piece: &Piece) -> Vec<DVec3> {
+    let mut points = Vec::new();
+    for seg in piece.curve.bezier_segments() {
+        let (a, b) = (seg.t0.max(piece.t0), seg.t1.min(piece.t1));
+        if a >= b || a.is_nan() || b.is_nan() {
+            continue;
+        }
+        let first = if points.is_empty() { 0 } else { 1 };
+        for k in first..=PROJECTED_PER_SEGMENT {
+            let t = a + (b - a) * k as f64 / PROJECTED_PER_SEGMENT as f64;
+            points.push(piece.curve.eval(t));
+        }
+    }
+    points
+}
+
+/// A 190–198 surface over the box of its loops. Parameter-space curves apply as written
+/// (the trim parameters are the standard's); model-space curves are mapped to parameters
+/// in closed form, angles unwrapped along the curve so a loop crossing the seam stays
+/// connected.
+fn analytic_with_loops(
+    model: &Model,
+    placed: &Placed,
+    loops: &[Boundary],
+) -> Result<Surface, String> {
+    let plane = matches!(placed.shape, Elementary::Plane);
+    let frame = placed_frame(placed);
+    let angular = placed.angular();
+    let mut trims = Vec::new();
+    for l in loops {
+        let mut segments = Vec::new();
+        for e in &l.edges {
+            // Form 0 has no parameterisation the writer and this reader share: its
+            // parameter-space curves are the last resort.
+            let prefer_model = l.model_preferred || !placed.parameterised;
+            if let Some(s) = parameter_segments(model, prefer_model, e, [(1.0, 0.0), (1.0, 0.0)])? {
+                segments.extend(s);
+                continue;
+            }
+            for piece in edge_pieces(model, e.model, e.reversed)? {
+                if plane {
+                    // The parameters of a plane are its frame coordinates: exact.
+                    segments.push(in_frame(&frame, piece));
+                    continue;
+                }
+                let mut points: Vec<DVec2> = Vec::new();
+                for q in samples(&piece) {
+                    let mut uv = placed.parameters_of(q);
+                    // Unwrap against the previous point of the loop (its last segment).
+                    let prev = points
+                        .last()
+                        .copied()
+                        .or_else(|| segments.last().map(segment_end));
+                    if let Some(prev) = prev {
+                        for (k, periodic) in angular.iter().enumerate() {
+                            if *periodic {
+                                uv[k] += ((prev[k] - uv[k]) / std::f64::consts::TAU).round()
+                                    * std::f64::consts::TAU;
+                            }
+                        }
+                    }
+                    points.push(uv);
+                }
+                if points.len() >= 2 {
+                    segments.push(TrimSegment::polyline(&points));
+                }
+            }
+        }
+        trims.push(TrimLoop {
+            hole: l.hole,
+            segments,
+        });
+    }
+    if plane && !placed.parameterised {
+        return planar(&frame, trims);
+    }
+    let [u, v] = if trims.iter().any(|l| !l.hole) {
+        let (lo, hi) = control_box(&trims);
+        [[lo.x, hi.x], [lo.y, hi.y]]
+    } else {
+        placed.closed_box().ok_or(
+            "a cylinder, cone or plane (190–194) without an outer boundary has no extent to draw",
+        )?
+    };
+    let (surface, maps) = placed.surface(u, v)?;
+    Ok(Surface {
+        geometry: SurfaceGeometry::Nurbs(surface),
+        trims,
+        trim_space: maps,
+    })
+}
+
+/// The model-space frame of a placed plane (its transform applied to the frame).
+fn placed_frame(placed: &Placed) -> Frame {
+    let m = placed.to_model;
+    let f = &placed.frame;
+    Frame {
+        origin: m.transform_point3(f.origin),
+        x: m.transform_vector3(f.x),
+        y: m.transform_vector3(f.y),
+        z: m.transform_vector3(f.z),
+    }
+}
+
+fn segment_end(s: &TrimSegment) -> DVec2 {
+    let q = s.curve.points[s.curve.points.len() - 1];
+    DVec2::new(q.x / q.z, q.y / q.z)
+}
+
+/// The box of the loops' control points, which holds the loops (convex hull property).
+fn control_box(trims: &[TrimLoop]) -> (DVec2, DVec2) {
+    let mut lo = DVec2::splat(f64::INFINITY);
+    let mut hi = DVec2::splat(f64::NEG_INFINITY);
+    for q in trims
+        .iter()
+        .flat_map(|l| &l.segments)
+        .flat_map(|s| &s.curve.points)
+    {
+        let e = DVec2::new(q.x / q.z, q.y / q.z);
+        lo = lo.min(e);
+        hi = hi.max(e);
+    }
+    (lo, hi)
 }
 
 /// The surface with its loops; a 128 whose range is narrower than its knots and that has
@@ -100,94 +506,6 @@ fn rectangle(u0: f64, u1: f64, v0: f64, v1: f64) -> TrimLoop {
     }
 }
 
-/// The model-space curve of a 142.
-fn model_curve(model: &Model, pointer: usize) -> Result<Vec<Piece>, String> {
-    match model.get(pointer)?.1 {
-        Entity::CurveOnSurface { model_curve, .. } if *model_curve != 0 => {
-            curves::pieces(model, *model_curve)
-        }
-        Entity::CurveOnSurface { .. } => Err(format!(
-            "the boundary D {pointer} of a plane has no model-space curve"
-        )),
-        _ => Err(format!(
-            "the boundary D {pointer} is not a curve on a surface (142)"
-        )),
-    }
-}
-
-/// The loop segments of one 142 boundary of a parametric surface.
-fn boundary(
-    model: &Model,
-    pointer: usize,
-    c: &Converted,
-    inverter: &mut Option<Inverter>,
-    report: &mut Report,
-) -> Result<Vec<TrimSegment>, String> {
-    let Entity::CurveOnSurface {
-        parameter_curve,
-        model_curve,
-        preferred,
-        ..
-    } = model.get(pointer)?.1
-    else {
-        return Err(format!(
-            "the boundary D {pointer} is not a curve on a surface (142)"
-        ));
-    };
-    if *parameter_curve != 0 && (*preferred != 2 || *model_curve == 0) {
-        // Affine in (u, v), so exact on the homogeneous points.
-        let [(su, ou), (sv, ov)] = c.to_trim;
-        return Ok(curves::pieces(model, *parameter_curve)?
-            .into_iter()
-            .map(|p| TrimSegment {
-                t0: p.t0,
-                t1: p.t1,
-                curve: ParamCurve {
-                    degree: p.curve.degree,
-                    knots: p.curve.knots,
-                    points: p
-                        .curve
-                        .points
-                        .iter()
-                        .map(|q| DVec3::new(su * q.x + ou * q.w, sv * q.y + ov * q.w, q.w))
-                        .collect(),
-                },
-            })
-            .collect());
-    }
-    if *model_curve == 0 {
-        return Err(format!(
-            "the boundary D {pointer} has neither a parameter-space nor a model-space curve"
-        ));
-    }
-    let inv = inverter.get_or_insert_with(|| Inverter::new(&c.surface));
-    let mut segments = Vec::new();
-    for piece in curves::pieces(model, *model_curve)? {
-        let mut points = Vec::new();
-        for seg in piece.curve.bezier_segments() {
-            let (a, b) = (seg.t0.max(piece.t0), seg.t1.min(piece.t1));
-            if a >= b || a.is_nan() || b.is_nan() {
-                continue;
-            }
-            let first = if points.is_empty() { 0 } else { 1 };
-            for k in first..=PROJECTED_PER_SEGMENT {
-                let t = a + (b - a) * k as f64 / PROJECTED_PER_SEGMENT as f64;
-                let q = piece.curve.eval(t);
-                let hit = inv
-                    .project(q)
-                    .ok_or("a model-space trim point could not be projected")?;
-                report.max_projection_error = report.max_projection_error.max(hit.distance);
-                points.push(DVec2::new(c.maps[0].apply(hit.u), c.maps[1].apply(hit.v)));
-            }
-        }
-        if points.len() >= 2 {
-            segments.push(TrimSegment::polyline(&points));
-        }
-    }
-    report.projected += 1;
-    Ok(segments)
-}
-
 fn transform(points: &mut [DVec4], m: &glam::DAffine3) {
     for p in points {
         let e = m.transform_point3(p.truncate() / p.w);
@@ -195,56 +513,34 @@ fn transform(points: &mut [DVec4], m: &glam::DAffine3) {
     }
 }
 
-/// A 108 plane (in model space, its transform applied) as a bilinear patch around the
-/// given model-space loops, which become its trims. The frame: normal (A, B, C), origin the
-/// plane's point nearest the definition origin.
-fn plane(model: &Model, pointer: usize, loops: Vec<(bool, Vec<Piece>)>) -> Result<Surface, String> {
-    let (entry, entity) = model.get(pointer)?;
-    let Entity::Plane { coefficients, .. } = entity else {
-        return Err(format!("D {pointer} is not a plane (108)"));
-    };
-    let [a, b, cc, d] = *coefficients;
-    let n = DVec3::new(a, b, cc);
-    let m = model.transform(entry.transform)?;
-    let origin = m.transform_point3(n * (d / n.length_squared()));
-    let frame = Frame::new(origin, m.transform_vector3(n), None).map_err(|e| e.to_string())?;
-    let mut lo = DVec3::splat(f64::INFINITY);
-    let mut hi = DVec3::splat(f64::NEG_INFINITY);
-    let mut trims = Vec::new();
-    for (hole, pieces) in loops {
-        let segments: Vec<TrimSegment> = pieces
-            .into_iter()
-            .map(|p| {
-                let points: Vec<DVec3> = p
-                    .curve
-                    .points
-                    .iter()
-                    .map(|q| {
-                        let r = q.truncate() - frame.origin * q.w;
-                        DVec3::new(r.dot(frame.x), r.dot(frame.y), q.w)
-                    })
-                    .collect();
-                for q in &points {
-                    let e = *q / q.z;
-                    lo = lo.min(e);
-                    hi = hi.max(e);
-                }
-                TrimSegment {
-                    t0: p.t0,
-                    t1: p.t1,
-                    curve: ParamCurve {
-                        degree: p.curve.degree,
-                        knots: p.curve.knots,
-                        points,
-                    },
-                }
-            })
-            .collect();
-        trims.push(TrimLoop { hole, segments });
+/// A model-space curve piece in the plane's frame coordinates: the projection along the
+/// normal is affine, so exact on the homogeneous control points.
+fn in_frame(frame: &Frame, p: Piece) -> TrimSegment {
+    let points = p
+        .curve
+        .points
+        .iter()
+        .map(|q| {
+            let r = q.truncate() - frame.origin * q.w;
+            DVec3::new(r.dot(frame.x), r.dot(frame.y), q.w)
+        })
+        .collect();
+    TrimSegment {
+        t0: p.t0,
+        t1: p.t1,
+        curve: ParamCurve {
+            degree: p.curve.degree,
+            knots: p.curve.knots,
+            points,
+        },
     }
-    // The control polygons' box holds the curves (convex hull property).
-    let (s, maps) = analytic::plane(&frame, lo.x, hi.x, lo.y, hi.y)
-        .map_err(|e| format!("plane bounds: {e}"))?;
+}
+
+/// A plane as a bilinear patch in `frame` around its loops (in frame coordinates).
+fn planar(frame: &Frame, trims: Vec<TrimLoop>) -> Result<Surface, String> {
+    let (lo, hi) = control_box(&trims);
+    let (s, maps) =
+        analytic::plane(frame, lo.x, hi.x, lo.y, hi.y).map_err(|e| format!("plane bounds: {e}"))?;
     Ok(Surface {
         geometry: SurfaceGeometry::Nurbs(s),
         trims,
