@@ -15,6 +15,7 @@ pub mod cli;
 pub mod diff;
 pub mod geom;
 pub mod kernel;
+pub mod progress;
 pub mod render;
 pub mod scene;
 pub mod tessellate;

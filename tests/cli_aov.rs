@@ -6,7 +6,7 @@ mod common;
 
 use std::collections::BTreeMap;
 
-use common::{render, run, stderr, stdout, testdata};
+use common::{render, run, stderr, testdata, trace_rows};
 use exr::prelude::*;
 
 const W: u32 = 24;
@@ -88,19 +88,10 @@ fn aov_layers_open_in_an_exr_reader_and_agree_with_trace() {
             eye[0], eye[1], eye[2], d[0], d[1], d[2]
         );
     }
-    let ray_file = dir.path().join("rays.txt");
-    std::fs::write(&ray_file, rays).unwrap();
-    let o = run(&[
-        "trace",
-        testdata("teapot.ron").to_str().unwrap(),
-        "--rays",
-        ray_file.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let csv = stdout(&o);
+    let rows = trace_rows(&testdata("teapot.ron"), &rays, &[]);
+    assert_eq!(rows.len(), pixels.len());
     let (mut hits, mut misses) = (0, 0);
-    for (row, &(x, y)) in csv.lines().skip(1).zip(&pixels) {
-        let f: Vec<&str> = row.split(',').collect();
+    for (f, &(x, y)) in rows.iter().zip(&pixels) {
         let i = (y * W + x) as usize;
         if f[1] == "0" {
             misses += 1;

@@ -12,6 +12,7 @@ use patchtrace::kernel::KernelStats;
 use patchtrace::kernel::subdivision::{
     PreparedPatch, SplitHeuristic, SubdivisionConfig, Termination, intersect, intersect_f64,
 };
+use patchtrace::progress::ProgressBar;
 use patchtrace::render::camera::CameraRays;
 use patchtrace::scene::rays::RayQuery;
 use patchtrace::scene::{Scene, load_scene};
@@ -81,7 +82,10 @@ fn float_precision_beats_the_finest_tessellation_a_hundredfold_and_adaptive_sits
         Method::Tessellated(512),
         Method::Tessellated(131072),
     ];
-    let results = accuracy::run(&scene, &rays, &methods, |_| {}).unwrap();
+    let progress = ProgressBar::hidden();
+    let results = accuracy::run(&scene, &rays, &methods, &progress).unwrap();
+    // The reference and each method counted once.
+    assert_eq!((progress.position(), progress.length()), (5, Some(5)));
     let float = row(&results, "float, length heuristic");
     let adaptive = row(&results, "adaptive, half pixel");
     let coarse = row(&results, "512 triangles/patch");

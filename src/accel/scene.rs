@@ -26,6 +26,7 @@ use crate::kernel::triangle::{
     self, PACK_WIDTH, PackShear, RayShear, TriangleHit, TrianglePack, intersect_pack,
 };
 use crate::kernel::{KernelStats, PatchHit};
+use crate::progress::ProgressBar;
 use crate::scene::{Geometry, Scene};
 
 /// Which intersection path answers queries.
@@ -290,7 +291,7 @@ impl<'a> Split<'a> {
     fn prepare_prototypes(&self) -> Vec<SceneGeometry> {
         self.prototypes
             .iter()
-            .map(|g| SceneGeometry::build_own(&[(0, g)], &[], Vec::new()))
+            .map(|g| SceneGeometry::build_own(&[(0, g)], &[], Vec::new(), &ProgressBar::hidden()))
             .collect()
     }
 }
@@ -298,9 +299,16 @@ impl<'a> Split<'a> {
 impl SceneGeometry {
     /// Prepares the patches and builds the BVH, with instances under a top-level BVH.
     pub fn build(scene: &Scene) -> SceneGeometry {
+        Self::build_with(scene, &ProgressBar::hidden())
+    }
+
+    /// [`build`](Self::build), advancing `progress` to twice the top-level primitive
+    /// count: one step per primitive bounded (a trimmed patch's box is the costly part),
+    /// one per primitive placed in a BVH leaf. Instances count as one primitive each.
+    pub fn build_with(scene: &Scene, progress: &ProgressBar) -> SceneGeometry {
         let split = Split::of(scene);
         let prototypes = split.prepare_prototypes();
-        SceneGeometry::build_own(&split.own, &split.instances, prototypes)
+        SceneGeometry::build_own(&split.own, &split.instances, prototypes, progress)
     }
 
     /// The BVH over `own`'s primitives and the boxes of the instances `placed` (object,
@@ -309,15 +317,21 @@ impl SceneGeometry {
         own: &[(u32, &Geometry)],
         placed: &[(u32, u32, glam::DAffine3)],
         prototypes: Vec<SceneGeometry>,
+        progress: &ProgressBar,
     ) -> SceneGeometry {
         let patches = collect_patches(own);
         let triangles = collect_triangles(own);
         let instances = place(placed, &prototypes, patches.originals.len());
+        let primitives = patches.originals.len() + triangles.corners.len() + instances.len();
+        progress.set_length(2 * primitives as u64);
         let boxes: Vec<Aabb> = patches
             .originals
             .iter()
             .zip(&patches.trims)
-            .map(|(p, trim)| surviving_box(p, trim.as_deref()).to_f32_outward())
+            .map(|(p, trim)| {
+                progress.inc(1);
+                surviving_box(p, trim.as_deref()).to_f32_outward()
+            })
             .chain(
                 triangles
                     .corners
@@ -326,7 +340,8 @@ impl SceneGeometry {
             )
             .chain(instances.iter().map(|i| i.bounds))
             .collect();
-        let bvh = Bvh::build_packed(&boxes, patches.originals.len());
+        progress.inc((triangles.corners.len() + instances.len()) as u64);
+        let bvh = Bvh::build_packed_with(&boxes, patches.originals.len(), progress);
         let accel = Accel::bvh(bvh, patches.originals.len(), &triangles);
         Self::with_accel(patches, triangles, accel, instances, prototypes)
     }

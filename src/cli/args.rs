@@ -163,6 +163,9 @@ pub struct InfoArgs {
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
+    /// No progress bars.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 #[derive(Debug, Args)]
@@ -175,6 +178,9 @@ pub struct ImportArgs {
     /// (non-rational patches) or .obj (free-form Bézier patches).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// No progress bars.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 #[derive(Debug, Args)]
@@ -189,6 +195,9 @@ pub struct ConvertArgs {
     /// Print the report as JSON.
     #[arg(long)]
     pub json: bool,
+    /// No progress bars.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 /// Intersection kernel.
@@ -454,6 +463,9 @@ pub struct TraceArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// No progress bars.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 #[derive(Debug, Args)]
@@ -465,6 +477,9 @@ pub struct BvhArgs {
     /// Output BVH file.
     #[arg(short, long)]
     pub output: PathBuf,
+    /// No progress bars.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 #[derive(Debug, Args)]

@@ -5,7 +5,6 @@ use std::process::ExitCode;
 
 use crate::bench::stability::{self, KernelPath, SuiteSize, report};
 use crate::cli::args::StabilityArgs;
-use crate::render::renderer::progress_bar;
 use crate::scene::write::write_atomic;
 
 pub fn stability(args: StabilityArgs) -> anyhow::Result<ExitCode> {
@@ -14,7 +13,7 @@ pub fn stability(args: StabilityArgs) -> anyhow::Result<ExitCode> {
     } else {
         SuiteSize::Reduced
     };
-    let bar = progress_bar(args.quiet, "stability");
+    let bar = crate::progress::bar(args.quiet, "stability");
     let results = stability::run_suite(size, args.seed, KernelPath::ALL, &bar);
     if let Some(path) = &args.csv {
         let text = report::csv(&results);

@@ -7,14 +7,14 @@ use anyhow::Context;
 
 use crate::bench::accuracy::{self, Method, plot};
 use crate::cli::args::AccuracyArgs;
+use crate::cli::setup::load;
 use crate::render::camera::CameraRays;
 use crate::scene::error::read_text;
-use crate::scene::load_scene_with;
 use crate::scene::rays::{RayQuery, parse_rays};
 use crate::scene::write::write_atomic;
 
 pub fn run(args: AccuracyArgs) -> anyhow::Result<ExitCode> {
-    let mut scene = load_scene_with(&args.scene, args.mesh.load_options())?;
+    let mut scene = load(&args.scene, &args.mesh, args.quiet)?;
     if let Some(n) = args.size {
         anyhow::ensure!(n > 0, "--size must be at least 1");
         scene.camera.width = n;
@@ -47,11 +47,9 @@ pub fn run(args: AccuracyArgs) -> anyhow::Result<ExitCode> {
     let dists: &[u32] = if rational { &args.dists } else { &[] };
     let methods = Method::list(&args.depths, dists, &args.triangles);
     let quiet = args.quiet;
-    let results = accuracy::run(&scene, &rays, &methods, |what| {
-        if !quiet {
-            eprintln!("tracing {} rays: {what}", rays.len());
-        }
-    })?;
+    let bar = crate::progress::bar(quiet, "accuracy");
+    let results = accuracy::run(&scene, &rays, &methods, &bar)?;
+    bar.finish_and_clear();
 
     std::fs::create_dir_all(&args.out_dir)
         .with_context(|| format!("creating {}", args.out_dir.display()))?;

@@ -7,7 +7,6 @@ use crate::bench::lg90::{self, CASES, Config, Method, report};
 use crate::cli::args::Lg90Args;
 use crate::cli::setup::thread_pool;
 use crate::kernel::cached::DEFAULT_CACHE_BYTES;
-use crate::render::renderer::progress_bar;
 use crate::scene::write::write_atomic;
 
 pub fn run(args: Lg90Args) -> anyhow::Result<ExitCode> {
@@ -51,7 +50,7 @@ pub fn run(args: Lg90Args) -> anyhow::Result<ExitCode> {
             .or_else(|| temp.clone())
             .unwrap_or_default(),
     };
-    let bar = progress_bar(args.quiet, "lg90");
+    let bar = crate::progress::bar(args.quiet, "lg90");
     let results = pool.install(|| lg90::run(&config, &bar));
     if let Some(dir) = &temp {
         let _ = std::fs::remove_dir_all(dir);

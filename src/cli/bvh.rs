@@ -3,14 +3,13 @@
 use std::process::ExitCode;
 use std::time::Instant;
 
-use crate::accel::scene::SceneGeometry;
 use crate::cli::args::BvhArgs;
-use crate::scene::load_scene_with;
+use crate::cli::setup::{build_bvh, load};
 
 pub fn run(args: BvhArgs) -> anyhow::Result<ExitCode> {
-    let scene = load_scene_with(&args.scene, args.mesh.load_options())?;
+    let scene = load(&args.scene, &args.mesh, args.quiet)?;
     let start = Instant::now();
-    let geometry = SceneGeometry::build(&scene);
+    let geometry = build_bvh(&scene, args.quiet);
     let build = start.elapsed().as_secs_f64();
     geometry.save_bvh(&args.output)?;
     eprintln!(

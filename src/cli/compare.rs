@@ -10,10 +10,10 @@ use std::time::Instant;
 
 use anyhow::Context;
 
-use crate::accel::scene::{Precision, SceneGeometry};
+use crate::accel::scene::Precision;
 use crate::bench::accuracy::patch_memory;
 use crate::cli::args::CompareArgs;
-use crate::cli::setup::thread_pool;
+use crate::cli::setup::{build_bvh, load, tessellate, thread_pool};
 use crate::diff::heatmap::heat_map;
 use crate::diff::{DiffOptions, Image, diff_images};
 use crate::kernel::secondary::DEFAULT_ULPS;
@@ -21,10 +21,10 @@ use crate::kernel::subdivision::SubdivisionConfig;
 use crate::render::film::Film;
 use crate::render::integrator::{Integrator, TraceSettings};
 use crate::render::plan::EffectPlan;
-use crate::render::renderer::{progress_bar, render_image};
+use crate::render::renderer::render_image;
+use crate::scene::Scene;
 use crate::scene::write::write_atomic;
-use crate::scene::{Scene, load_scene_with};
-use crate::tessellate::{TessellationMode, tessellate_scene};
+use crate::tessellate::TessellationMode;
 
 /// One line of the table.
 struct Row {
@@ -44,7 +44,7 @@ struct Row {
 /// Builds the accelerator and renders, timing both.
 fn render(scene: &Scene, quiet: bool, label: &str, pool: &rayon::ThreadPool) -> (Film, f64, f64) {
     let start = Instant::now();
-    let geometry = SceneGeometry::build(scene);
+    let geometry = build_bvh(scene, quiet);
     let build = start.elapsed().as_secs_f64();
     let integrator = Integrator {
         scene,
@@ -55,7 +55,7 @@ fn render(scene: &Scene, quiet: bool, label: &str, pool: &rayon::ThreadPool) -> 
             plan: EffectPlan::for_scene(scene),
         },
     };
-    let bar = progress_bar(quiet, label);
+    let bar = crate::progress::bar(quiet, label);
     let start = Instant::now();
     let film = pool.install(|| render_image(&integrator, &bar)).film;
     (film, build, start.elapsed().as_secs_f64())
@@ -63,7 +63,7 @@ fn render(scene: &Scene, quiet: bool, label: &str, pool: &rayon::ThreadPool) -> 
 
 pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     let pool = thread_pool(args.threads)?;
-    let mut scene = load_scene_with(&args.scene, args.mesh.load_options())?;
+    let mut scene = load(&args.scene, &args.mesh, args.quiet)?;
     args.size.apply(&args.scene, &mut scene)?;
     crate::scene::check_film_pixels(scene.camera.width, scene.camera.height)
         .map_err(crate::cli::BadArgument)?;
@@ -91,9 +91,14 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
 
     for &n in &args.triangles {
         let start = Instant::now();
-        let (meshes, report) = tessellate_scene(&scene, TessellationMode::TrianglesPerPatch(n))?;
-        let tessellate_seconds = start.elapsed().as_secs_f64();
         let label = format!("{n} triangles/patch");
+        let (meshes, report) = tessellate(
+            &scene,
+            TessellationMode::TrianglesPerPatch(n),
+            args.quiet,
+            &format!("tessellating, {label}"),
+        )?;
+        let tessellate_seconds = start.elapsed().as_secs_f64();
         let (film, build, render_seconds) = render(&meshes, args.quiet, &label, &pool);
         film.write(&args.out_dir.join(format!("tess{n}.png")))?;
         let d = diff_images(&reference, &Image::from_film(&film), DiffOptions::default())?;

@@ -4,11 +4,12 @@ use std::io::Write;
 use std::process::ExitCode;
 
 use crate::cli::args::ConvertArgs;
+use crate::cli::setup::load;
 use crate::scene::convert::convert_scene;
-use crate::scene::{load_scene_with, write::write_scene_as};
+use crate::scene::write::write_scene_as;
 
 pub fn run(args: ConvertArgs) -> anyhow::Result<ExitCode> {
-    let scene = load_scene_with(&args.input, args.mesh.load_options())?;
+    let scene = load(&args.input, &args.mesh, args.quiet)?;
     let (converted, report) = convert_scene(&scene);
     write_scene_as(&args.output, &converted)?;
     let mut out = std::io::stdout().lock();

@@ -3,10 +3,11 @@
 use std::process::ExitCode;
 
 use crate::cli::args::ImportArgs;
-use crate::scene::{load_scene_with, write::write_scene_as};
+use crate::cli::setup::load;
+use crate::scene::write::write_scene_as;
 
 pub fn run(args: ImportArgs) -> anyhow::Result<ExitCode> {
-    let scene = load_scene_with(&args.input, args.mesh.load_options())?;
+    let scene = load(&args.input, &args.mesh, args.quiet)?;
     write_scene_as(&args.output, &scene)?;
     eprintln!(
         "imported {} object(s), {} patch(es) from {} to {}",

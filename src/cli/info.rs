@@ -8,7 +8,9 @@ use crate::scene::load::{InputKind, load_scene_noted};
 use crate::scene::summary::summarize;
 
 pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
-    let (scene, notes) = load_scene_noted(&args.scene, args.mesh.load_options())?;
+    let (scene, notes) = crate::progress::while_reading(args.quiet, &args.scene, || {
+        load_scene_noted(&args.scene, args.mesh.load_options())
+    })?;
     let s = summarize(&scene);
     let mut out = std::io::stdout().lock();
     if args.json {

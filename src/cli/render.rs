@@ -14,7 +14,7 @@ use crate::render::film::{ImageFormat, sibling, write_effort_png};
 use crate::render::integrator::{Integrator, TraceSettings};
 use crate::render::piece::{PieceInfo, fingerprint, write_exr, write_png};
 use crate::render::plan::EffectPlan;
-use crate::render::renderer::{RenderJob, progress_bar, render};
+use crate::render::renderer::{RenderJob, render};
 use crate::render::sampler::SampleCount;
 use crate::render::stats::{PhaseTimes, RayReport};
 use crate::render::window::Window;
@@ -153,7 +153,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         .into());
     }
     let pool = thread_pool(args.threads)?;
-    let mut prepared = prepare(&args.scene, &args.mesh, &args.kernel)?;
+    let mut prepared = prepare(&args.scene, &args.mesh, &args.kernel, args.quiet)?;
     args.size.apply(&args.scene, &mut prepared.scene)?;
     let plan = EffectPlan {
         trims: prepared.trims,
@@ -228,7 +228,7 @@ fn render_frame(
         window,
         provenance: provenance(scene, args, samples, frame),
     };
-    let bar = progress_bar(args.quiet, "rendering");
+    let bar = crate::progress::bar(args.quiet, "rendering");
     let start = Instant::now();
     let rendered = pool.install(|| render(&integrator, &job, &bar));
     let (film, tally) = (&rendered.film, &rendered.tally);

@@ -17,6 +17,9 @@ use crate::kernel::toth::TothConfig;
 use crate::render::camera::CameraRays;
 use crate::render::plan::TrimEffect;
 use crate::scene::{Camera, Scene, load_scene_with};
+use crate::tessellate::{
+    TessellateError, TessellationMode, TessellationReport, tessellate_scene_with,
+};
 
 /// The kernel path selected by the flags, or why the flags do not go together; `camera`
 /// sizes the pixels of adaptive termination.
@@ -88,15 +91,26 @@ pub struct Prepared {
     pub trims: TrimEffect,
 }
 
+/// Reads the scene at `path` with `--subdivide`'s options, under a spinner when the file is
+/// large ([`while_reading`](crate::progress::while_reading)), unless `quiet`.
+pub fn load(path: &Path, mesh: &MeshArgs, quiet: bool) -> Result<Scene, crate::scene::LoadError> {
+    crate::progress::while_reading(quiet, path, || load_scene_with(path, mesh.load_options()))
+}
+
 /// Loads the scene and prepares its geometry: builds the BVH or loads `--bvh`, or builds
-/// the grid for `--accel grid`.
-pub fn prepare(scene_path: &Path, mesh: &MeshArgs, args: &KernelArgs) -> anyhow::Result<Prepared> {
+/// the grid for `--accel grid`, with progress unless `quiet`.
+pub fn prepare(
+    scene_path: &Path,
+    mesh: &MeshArgs,
+    args: &KernelArgs,
+    quiet: bool,
+) -> anyhow::Result<Prepared> {
     anyhow::ensure!(
         args.accel == AccelChoice::Bvh || args.bvh.is_none(),
         "--bvh loads a BVH file, which --accel grid does not use; drop one of the two flags"
     );
     let start = Instant::now();
-    let mut scene = load_scene_with(scene_path, mesh.load_options())?;
+    let mut scene = load(scene_path, mesh, quiet)?;
     let trims = TrimEffect::of(&scene, args.ignore_trims);
     if args.ignore_trims {
         scene = scene.without_trims();
@@ -105,9 +119,12 @@ pub fn prepare(scene_path: &Path, mesh: &MeshArgs, args: &KernelArgs) -> anyhow:
     let start = Instant::now();
     let geometry = match (args.accel, &args.bvh) {
         (AccelChoice::Bvh, Some(path)) => SceneGeometry::load(&scene, path)?,
-        (AccelChoice::Bvh, None) => SceneGeometry::build(&scene),
+        (AccelChoice::Bvh, None) => build_bvh(&scene, quiet),
         (AccelChoice::Grid, _) => {
-            SceneGeometry::build_grid(&scene, args.grid_budget.saturating_mul(1 << 20))
+            let spinner = crate::progress::spinner(quiet, "building the grid");
+            let grid = SceneGeometry::build_grid(&scene, args.grid_budget.saturating_mul(1 << 20));
+            spinner.finish_and_clear();
+            grid
         }
     };
     Ok(Prepared {
@@ -117,6 +134,29 @@ pub fn prepare(scene_path: &Path, mesh: &MeshArgs, args: &KernelArgs) -> anyhow:
         prepare_seconds: start.elapsed().as_secs_f64(),
         trims,
     })
+}
+
+/// Prepares the scene's geometry and builds its BVH under a progress bar, unless `quiet`.
+pub fn build_bvh(scene: &Scene, quiet: bool) -> SceneGeometry {
+    let bar = crate::progress::bar(quiet, "building BVH");
+    let geometry = SceneGeometry::build_with(scene, &bar);
+    bar.finish_and_clear();
+    geometry
+}
+
+/// Tessellates `scene` under a progress bar labelled `label`, one step per patch, unless
+/// `quiet`.
+pub fn tessellate(
+    scene: &Scene,
+    mode: TessellationMode,
+    quiet: bool,
+    label: &str,
+) -> Result<(Scene, TessellationReport), TessellateError> {
+    let bar = crate::progress::bar(quiet, label);
+    bar.set_length(scene.patch_count() as u64);
+    let result = tessellate_scene_with(scene, mode, &mut || bar.inc(1));
+    bar.finish_and_clear();
+    result
 }
 
 /// Most `--threads` per core. Work is split into many more pieces than threads, so more

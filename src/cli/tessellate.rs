@@ -7,10 +7,9 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::cli::args::TessellateArgs;
-use crate::scene::{LoadError, load_scene_with};
-use crate::tessellate::{
-    MeshFormat, TessellationMode, TessellationReport, tessellate_scene_with, write_mesh_scene,
-};
+use crate::cli::setup::{load, tessellate};
+use crate::scene::LoadError;
+use crate::tessellate::{MeshFormat, TessellationMode, TessellationReport, write_mesh_scene};
 
 /// Triangles per patch when no mode is given: Dammertz's coarsest table row.
 const DEFAULT_TRIANGLES_PER_PATCH: u32 = 512;
@@ -46,12 +45,9 @@ pub fn run(args: TessellateArgs) -> anyhow::Result<ExitCode> {
         )
         .into());
     }
-    let scene = load_scene_with(&args.scene, args.mesh.load_options())?;
+    let scene = load(&args.scene, &args.mesh, args.quiet)?;
     let start = Instant::now();
-    let bar = crate::render::renderer::progress_bar(args.quiet, "tessellating");
-    bar.set_length(scene.patch_count() as u64);
-    let (meshes, report) = tessellate_scene_with(&scene, mode(&args), &mut || bar.inc(1))?;
-    bar.finish_and_clear();
+    let (meshes, report) = tessellate(&scene, mode(&args), args.quiet, "tessellating")?;
     let seconds = start.elapsed().as_secs_f64();
     let file_bytes = write_mesh_scene(&args.output, &meshes)?;
     let r = Report {

@@ -4,7 +4,7 @@
 //! sampling order and any split into tiles.
 
 use glam::Vec4;
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 use rayon::prelude::*;
 
 use super::camera::CameraRays;
@@ -242,20 +242,4 @@ fn centre_hit(integrator: &Integrator, rays: &CameraRays, x: u32, y: u32) -> Opt
         hit,
         point: ray.origin.as_dvec3() + ray.dir.as_dvec3() * hit.t,
     })
-}
-
-/// A progress bar on stderr, hidden when `quiet` or when stderr is not a terminal.
-pub fn progress_bar(quiet: bool, message: &str) -> ProgressBar {
-    use std::io::IsTerminal;
-    if quiet || !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(0);
-    if let Ok(style) =
-        ProgressStyle::with_template("{msg} [{bar:40}] {percent:>3}% {elapsed_precise} (eta {eta})")
-    {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar.set_message(message.to_string());
-    bar
 }

@@ -9,6 +9,7 @@ use glam::DVec3;
 use super::{Bvh, MAX_DEPTH, MAX_LEAF_PRIMS, Node};
 use crate::geom::Aabb;
 use crate::kernel::triangle::PACK_WIDTH;
+use crate::progress::ProgressBar;
 
 /// Centroid bins per axis. Wald 2007 §3.1 finds 16–32 bins within a few percent of the full
 /// sweep SAH; the upper end costs little for patch counts.
@@ -44,8 +45,9 @@ pub(super) fn area(b: &Aabb) -> f64 {
 }
 
 /// The tree over `boxes`; primitives from `first_packed` on are priced in packs (see
-/// [`PACK_COST`]).
-pub(super) fn build(boxes: &[Aabb], first_packed: usize) -> Bvh {
+/// [`PACK_COST`]). `progress` advances by each leaf's primitives as the leaf is made, so it
+/// reaches `boxes.len()` when the tree is done.
+pub(super) fn build(boxes: &[Aabb], first_packed: usize, progress: &ProgressBar) -> Bvh {
     let n = boxes.len();
     // Indices are u32 in the file and the traversal callback.
     assert!(u32::try_from(n).is_ok(), "more than u32::MAX primitives");
@@ -58,6 +60,7 @@ pub(super) fn build(boxes: &[Aabb], first_packed: usize) -> Bvh {
         prims: (0..n as u32).collect(),
         first_packed: first_packed.min(n) as u32,
         nodes: Vec::with_capacity((2 * n).saturating_sub(1)),
+        progress,
     };
     if n > 0 {
         builder.nodes.push(Node {
@@ -77,6 +80,7 @@ struct Builder<'a> {
     /// Primitives with this index or above are tested in packs.
     first_packed: u32,
     nodes: Vec<Node>,
+    progress: &'a ProgressBar,
 }
 
 #[derive(Clone, Copy)]
@@ -122,6 +126,7 @@ impl Builder<'_> {
                 first: start as u32,
                 count: count as u32,
             };
+            self.progress.inc(count as u64);
             return;
         };
         let mid = match split {

@@ -25,6 +25,7 @@ pub use hash::GeometryHasher;
 pub use traverse::TraversalStats;
 
 use crate::geom::Aabb;
+use crate::progress::ProgressBar;
 
 /// Deepest node level (the root is level 0) the builder creates; below it a subtree becomes a
 /// leaf. Traversal keeps a fixed stack of this many entries, which suffices because it pushes
@@ -67,14 +68,20 @@ pub struct Bvh {
 impl Bvh {
     /// Builds the tree over `boxes`; primitive `i` is the one with box `boxes[i]`.
     pub fn build(boxes: &[Aabb]) -> Bvh {
-        build::build(boxes, boxes.len())
+        build::build(boxes, boxes.len(), &ProgressBar::hidden())
     }
 
     /// [`build`](Bvh::build) for a caller that tests primitives `first_packed..` in SIMD
     /// packs of [`PACK_WIDTH`](crate::kernel::triangle::PACK_WIDTH) (triangles): their leaves are priced per started pack, so the
     /// heuristic prefers full packs to more, emptier leaves.
     pub fn build_packed(boxes: &[Aabb], first_packed: usize) -> Bvh {
-        build::build(boxes, first_packed)
+        Bvh::build_packed_with(boxes, first_packed, &ProgressBar::hidden())
+    }
+
+    /// [`build_packed`](Bvh::build_packed), advancing `progress` by one per primitive as
+    /// the leaves are made.
+    pub fn build_packed_with(boxes: &[Aabb], first_packed: usize, progress: &ProgressBar) -> Bvh {
+        build::build(boxes, first_packed, progress)
     }
 
     /// Assembles a tree from its arrays (from another builder or a file), refusing any that

@@ -19,6 +19,7 @@ use crate::geom::{DAabb, Ray};
 use crate::kernel::cached::CachedConfig;
 use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig, Termination};
 use crate::kernel::toth::TothConfig;
+use crate::progress::ProgressBar;
 use crate::render::camera::CameraRays;
 use crate::scene::rays::RayQuery;
 use crate::scene::{Camera, Scene};
@@ -190,13 +191,16 @@ fn normal(h: &SceneHit, use_shading: bool) -> DVec3 {
     }
 }
 
-/// Runs every method over `rays` and compares with the `f64` reference.
+/// Runs every method over `rays` and compares with the `f64` reference; `progress` counts
+/// the reference and each method as it finishes, with the one running as its message.
 pub fn run(
     scene: &Scene,
     rays: &[RayQuery],
     methods: &[Method],
-    mut progress: impl FnMut(&str),
+    progress: &ProgressBar,
 ) -> anyhow::Result<Vec<MethodResult>> {
+    progress.set_length(1 + methods.len() as u64);
+    let step = |what: &str| progress.set_message(format!("tracing {} rays: {what}", rays.len()));
     let exact = SceneGeometry::build(scene);
     // Every method traces the rays rounded once to f32, and so does the reference, in
     // f64 (an f32 ray is exact in f64): the rounding of the ray itself moves the hit by
@@ -212,7 +216,7 @@ pub fn run(
             tmax: q.tmax as f32,
         })
         .collect();
-    progress("f64 reference");
+    step("f64 reference");
     let reference_cfg = SubdivisionConfig::default();
     let reference: Vec<Reference> = f32_rays
         .iter()
@@ -235,7 +239,8 @@ pub fn run(
 
     let mut results = Vec::new();
     for method in methods {
-        progress(&method.name());
+        progress.inc(1);
+        step(&method.name());
         let (geometry, memory) = match *method {
             Method::Tessellated(n) => {
                 let (meshes, report): (Scene, TessellationReport) =
@@ -298,6 +303,7 @@ pub fn run(
             memory_bytes: memory,
         });
     }
+    progress.inc(1);
     Ok(results)
 }
 
