@@ -137,30 +137,46 @@ fn merge_refuses_pieces_of_other_renders_gaps_and_overlaps() {
     assert!(!o.status.success());
 }
 
+/// Every subcommand of the clap model, nested ones too, as (its parents' names, its name).
+fn subcommands(cmd: &clap::Command, parents: &[String], out: &mut Vec<(Vec<String>, String)>) {
+    for s in cmd.get_subcommands() {
+        out.push((parents.to_vec(), s.get_name().to_string()));
+        let mut path = parents.to_vec();
+        path.push(s.get_name().to_string());
+        subcommands(s, &path, out);
+    }
+}
+
 #[test]
 fn completions_for_bash_and_zsh_name_every_subcommand() {
     use clap::CommandFactory;
-    let cmd = patchtrace::cli::Cli::command();
-    let names: Vec<String> = cmd
-        .get_subcommands()
-        .map(|s| s.get_name().to_string())
-        .collect();
-    assert!(names.len() >= 12 && names.iter().any(|n| n == "merge"));
+    let mut all = Vec::new();
+    subcommands(&patchtrace::cli::Cli::command(), &[], &mut all);
+    assert!(all.iter().filter(|(p, _)| p.is_empty()).count() >= 12);
+    assert!(all.iter().any(|(p, n)| p == &["bench"] && n == "stability"));
     for shell in ["bash", "zsh", "fish", "elvish", "powershell"] {
         let o = run(&["completions", shell]);
         assert!(o.status.success(), "{shell}: {}", stderr(&o));
         let script = String::from_utf8(o.stdout).unwrap();
-        // bash dispatches on `patchtrace,NAME)`, zsh lists `'NAME:description'`.
-        let pattern = |name: &str| match shell {
-            "bash" => Some(format!("patchtrace,{name})")),
+        // bash dispatches on `PARENT,NAME)` with PARENT `patchtrace__subcmd__bench` for
+        // `bench`'s subcommands; zsh lists `'NAME:description'` under its parent.
+        let pattern = |parents: &[String], name: &str| match shell {
+            "bash" => Some(format!(
+                "patchtrace{},{name})",
+                parents
+                    .iter()
+                    .map(|p| format!("__subcmd__{p}"))
+                    .collect::<String>()
+            )),
             "zsh" => Some(format!("'{name}:")),
             _ => None,
         };
-        for name in &names {
-            if let Some(p) = pattern(name) {
+        for (parents, name) in &all {
+            if let Some(p) = pattern(parents, name) {
                 assert!(
                     script.contains(&p),
-                    "{shell} completion does not name `{name}`"
+                    "{shell} completion does not name `{}`",
+                    [parents.join(" "), name.clone()].join(" ")
                 );
             }
         }
