@@ -1198,3 +1198,42 @@ fn subfigure_cycles_and_blow_ups_are_refused_by_name() {
         blown.report.failed.len()
     );
 }
+
+#[test]
+fn parabolic_conic_arc_in_general_position() {
+    let n = net();
+    // 2 x''² − y'' = 0 in axes turned by φ about c.
+    let (phi, c) = (0.7f64, DVec2::new(0.5, 0.4));
+    let (cp, sp) = (phi.cos(), phi.sin());
+    let (ka, kb, kc) = (2.0 * cp * cp, 4.0 * cp * sp, 2.0 * sp * sp);
+    let kd = -2.0 * ka * c.x - kb * c.y + sp;
+    let ke = -kb * c.x - 2.0 * kc * c.y - cp;
+    let kf = ka * c.x * c.x + kb * c.x * c.y + kc * c.y * c.y - sp * c.x + cp * c.y;
+    let on = |t: f64| c + DVec2::new(cp * t - sp * 2.0 * t * t, sp * t + cp * 2.0 * t * t);
+    let (s, e) = (on(0.2), on(-0.15));
+    let mut top = ent(144, &[de(0), 1.0, 1.0, 0.0, de(2)]);
+    top.subordinate = 0;
+    let read = read(&[
+        ent(128, &b128(&n, [0.0, 1.0, 0.0, 1.0])),
+        ent(104, &[ka, kb, kc, kd, ke, kf, 0.0, s.x, s.y, e.x, e.y]),
+        ent(142, &[0.0, de(0), de(1), 0.0, 1.0]),
+        top,
+    ]);
+    let (_, surface) = only(&read);
+    let seg = &surface.trims[0].segments[0];
+    let ends = [
+        trim_point(&seg.curve, seg.t0),
+        trim_point(&seg.curve, seg.t1),
+    ];
+    assert!(
+        (ends[0] - s).length() < REL && (ends[1] - e).length() < REL
+            || (ends[0] - e).length() < REL && (ends[1] - s).length() < REL,
+        "{ends:?}"
+    );
+    for i in 0..=16 {
+        let t = (seg.t0 + (seg.t1 - seg.t0) * i as f64 / 16.0).min(seg.t1);
+        let p = trim_point(&seg.curve, t);
+        let q = ka * p.x * p.x + kb * p.x * p.y + kc * p.y * p.y + kd * p.x + ke * p.y + kf;
+        assert!(q.abs() < 1e-12, "conic residual {q:e}");
+    }
+}

@@ -169,14 +169,21 @@ fn arc(z: f64, centre: DVec2, start: DVec2, end: DVec2) -> Result<Piece, String>
     ))
 }
 
-/// 104 (§4.5): an ellipse or hyperbola in general position (B² ≠ 4AC) is brought to its
-/// centre and axes and converted exactly; a parabola must be in a standard position
-/// (A x² + E y = 0 or C y² + D x = 0).
+/// B² − 4AC of a parabola written in decimal rounds to the file's precision of its terms
+/// rather than to zero (B = 4 cos φ sin φ, AC = 4 cos² φ sin² φ for a turned one). The
+/// ratio |B² − 4AC| / (B² + 4|AC|) is the ratio of the quadratic form's eigenvalues, so
+/// below this a conic would be an ellipse or hyperbola with axes more than 3·10⁴ : 1,
+/// which no CAD system writes; it is taken as the parabola the writer meant (9 significant
+/// digits or more suffice to land here).
+const PARABOLIC: f64 = 1e-9;
+
+/// 104 (§4.5): ellipses and hyperbolas (B² ≠ 4AC) are brought to their centre and axes,
+/// parabolas to their vertex and axis, and converted exactly, in any position.
 fn conic(k: &[f64; 6], z: f64, start: DVec2, end: DVec2) -> Result<Piece, String> {
     let [a, b, c, d, e, f] = *k;
     let disc = b * b - 4.0 * a * c;
     let err = |x: analytic::ShapeError| x.to_string();
-    if disc != 0.0 {
+    if disc.abs() > PARABOLIC * (b * b + (4.0 * a * c).abs()) {
         // Centre: the gradient vanishes. Axes: rotate by θ with tan 2θ = B / (A − C); in
         // the axes the conic is A' x'² + C' y'² + F' = 0.
         let det = 4.0 * a * c - b * b;
@@ -216,29 +223,47 @@ fn conic(k: &[f64; 6], z: f64, start: DVec2, end: DVec2) -> Result<Piece, String
             analytic::ellipse_arc(&frame, ra, rb, [t0, t1]).map_err(err)?,
         ));
     }
-    let frame = plane_frame(DVec3::new(0.0, 0.0, z));
-    if b == 0.0 && f == 0.0 {
-        if c == 0.0 && d == 0.0 && a != 0.0 && e != 0.0 {
-            // y = −(A/E) x²: the parabola of `analytic` with its axes swapped.
-            let fr = Frame {
-                origin: frame.origin,
-                x: DVec3::Y,
-                y: DVec3::X,
-                z: -DVec3::Z,
-            };
-            let (t0, t1) = (start.x.min(end.x), start.x.max(end.x));
-            return Ok(Piece::whole(
-                analytic::parabola_arc(&fr, -a / e, t0, t1).map_err(err)?,
-            ));
-        }
-        if a == 0.0 && e == 0.0 && c != 0.0 && d != 0.0 {
-            let (t0, t1) = (start.y.min(end.y), start.y.max(end.y));
-            return Ok(Piece::whole(
-                analytic::parabola_arc(&frame, -c / d, t0, t1).map_err(err)?,
-            ));
-        }
+    parabola(k, z, start, end)
+}
+
+/// The parabolic arc of a 104 (B² = 4AC). In the axes rotated by θ (tan 2θ = B / (A − C))
+/// the quadratic part is one square, A' x'² (the other coefficient is zero up to
+/// rounding, and the smaller one is taken as zero); completing the square,
+/// y' = −(A' X² + F') / E' with X = x' + D' / 2A', a parabola with its vertex at
+/// X = 0: `analytic::parabola_arc` in the frame (axis along y', parameter along x'), whose
+/// parameter is X.
+fn parabola(k: &[f64; 6], z: f64, start: DVec2, end: DVec2) -> Result<Piece, String> {
+    let [a, b, c, d, e, f] = *k;
+    let theta = 0.5 * b.atan2(a - c);
+    let (s, co) = theta.sin_cos();
+    let a2 = a * co * co + b * co * s + c * s * s;
+    let c2 = a * s * s - b * co * s + c * co * co;
+    let (e1, e2) = (DVec2::new(co, s), DVec2::new(-s, co));
+    // The square is in whichever rotated coordinate has the larger coefficient.
+    let (sq, lin, k2) = if a2.abs() >= c2.abs() {
+        (e1, e2, a2)
+    } else {
+        (e2, -e1, c2)
+    };
+    let d2 = d * sq.x + e * sq.y;
+    let e2c = d * lin.x + e * lin.y;
+    if k2 == 0.0 || e2c == 0.0 || !(k2 / e2c).is_finite() {
+        return Err("a degenerate parabola (a line or a pair of lines) is not a conic arc".into());
     }
-    Err("parabolic arcs other than in standard position (§4.5) are not supported yet".into())
+    let shift = d2 / (2.0 * k2);
+    let f2 = f - d2 * d2 / (4.0 * k2);
+    let vertex = sq * -shift + lin * (-f2 / e2c);
+    let frame = Frame {
+        origin: vertex.extend(z),
+        x: lin.extend(0.0),
+        y: sq.extend(0.0),
+        z: lin.extend(0.0).cross(sq.extend(0.0)),
+    };
+    let (ts, te) = (start.dot(sq) + shift, end.dot(sq) + shift);
+    Ok(Piece::whole(
+        analytic::parabola_arc(&frame, -k2 / e2c, ts.min(te), ts.max(te))
+            .map_err(|x| x.to_string())?,
+    ))
 }
 
 /// The hyperbolic arc of a 104 in its axes `[(e1, A'), (e2, C')]` about `centre`, where
