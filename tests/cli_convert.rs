@@ -16,7 +16,7 @@ fn patches_of(path: &std::path::Path) -> Vec<BezierPatch> {
                 SurfaceGeometry::Nurbs(n) => n.to_bezier_patches(),
             })
             .collect(),
-        Geometry::Mesh(_) | Geometry::Subdivision(_) => panic!("expected surfaces"),
+        other => panic!("expected surfaces, found {other:?}"),
     }
 }
 

@@ -1237,3 +1237,36 @@ fn parabolic_conic_arc_in_general_position() {
         assert!(q.abs() < 1e-12, "conic residual {q:e}");
     }
 }
+
+#[test]
+fn angles_beyond_a_turn_are_named_not_clamped() {
+    // A cylinder trimmed by a loop from 10 to 80 in u: degrees, not radians.
+    let mut cylinder = ent(192, &[de(0), de(1), 1.0, de(2)]);
+    cylinder.form = 1;
+    let mut polygon = ent(
+        106,
+        &[
+            1.0, 5.0, 0.0, 10.0, 0.0, 80.0, 0.0, 80.0, 1.0, 10.0, 1.0, 10.0, 0.0,
+        ],
+    );
+    polygon.form = 63;
+    let mut top = ent(144, &[de(3), 1.0, 0.0, de(5)]);
+    top.subordinate = 0;
+    let read = read(&[
+        vector(116, DVec3::ZERO),
+        vector(123, DVec3::Z),
+        vector(123, DVec3::X),
+        cylinder,
+        polygon,
+        ent(142, &[0.0, de(3), de(4), 0.0, 1.0]),
+        top,
+    ]);
+    assert!(read.surfaces.is_empty());
+    assert_eq!(read.report.failed.len(), 1);
+    assert!(
+        read.report.failed[0]
+            .starts_with("entity 144 (D 13): the trim loops span 70 in the angle u"),
+        "{:?}",
+        read.report.failed
+    );
+}

@@ -7,4 +7,5 @@
 
 pub mod bvh;
 pub mod grid;
+mod instance;
 pub mod scene;

@@ -3,15 +3,20 @@
 //! for the watertight kernel, and one accelerator over them: a BVH over the tight patch
 //! boxes (LG90 §3.1, Fig. 2) and the triangle boxes, or the uniform grid of LG90 §3.1.
 //! Primitive `i` of either is patch `i` when `i` is below the patch count, and triangle
-//! `i - patch count` otherwise. One query answers "nearest hit" or "anything in the way"
-//! for a ray, counting the work it did.
+//! `i - patch count` otherwise, up to the triangle count, and instance `i - patches -
+//! triangles` beyond that: instances (Dammertz §3.3, [`super::instance`]) share one
+//! prepared copy of their geometry, a `SceneGeometry` of its own in object space. One
+//! query answers "nearest hit" or "anything in the way" for a ray, counting the work it
+//! did.
 
+use std::borrow::Cow;
 use std::ops::ControlFlow;
 
 use glam::{DVec3, Vec3};
 
 use super::bvh::{Bvh, GeometryHasher};
 use super::grid::Grid;
+use super::instance::Placement;
 use crate::geom::trim::PatchTrim;
 use crate::geom::{Aabb, BezierPatch, DAabb, Ray};
 use crate::kernel::cached::{self, CachedConfig};
@@ -142,6 +147,7 @@ struct LeafPacks {
 
 impl LeafPacks {
     fn new(bvh: &Bvh, patches: u32, corners: &[[Vec3; 3]]) -> LeafPacks {
+        let triangles = patches..patches + corners.len() as u32;
         let mut leaves: Vec<(usize, usize)> = bvh
             .nodes()
             .iter()
@@ -160,7 +166,7 @@ impl LeafPacks {
             let in_leaf = &bvh.prim_indices()[first..first + count];
             let triangles: Vec<u32> = in_leaf
                 .iter()
-                .filter(|&&prim| prim >= patches)
+                .filter(|&&prim| triangles.contains(&prim))
                 .map(|&prim| prim - patches)
                 .collect();
             for chunk in triangles.chunks(PACK_WIDTH) {
@@ -193,6 +199,9 @@ enum Candidate {
     /// nearest ([`subdivision::KernelHit`]).
     Subdivision(u32, subdivision::KernelHit),
     Triangle(u32, TriangleHit),
+    /// A hit of instance `i`, finished in object space (each instance a ray hits finishes
+    /// its own nearest hit; rays meet few instances).
+    Instance(u32, Box<SceneHit>),
 }
 
 /// The ray as the `f32` subdivision kernel takes it, made at the first patch test of a
@@ -237,21 +246,83 @@ pub struct SceneGeometry {
     trims: Vec<Option<Box<PatchTrim>>>,
     triangles: Triangles,
     accel: Accel,
+    /// The instances, top-level primitives after the triangles, and the geometry they
+    /// share, each prepared once in object space (Dammertz §3.3).
+    instances: Vec<Placement>,
+    prototypes: Vec<SceneGeometry>,
+}
+
+/// The scene's objects split for preparation: those placed in world space, and the
+/// instances with the distinct geometry they share.
+struct Split<'a> {
+    own: Vec<(u32, &'a Geometry)>,
+    /// (object, prototype, object to world) per instance.
+    instances: Vec<(u32, u32, glam::DAffine3)>,
+    prototypes: Vec<&'a Geometry>,
+}
+
+impl<'a> Split<'a> {
+    fn of(scene: &'a Scene) -> Split<'a> {
+        let mut split = Split {
+            own: Vec::new(),
+            instances: Vec::new(),
+            prototypes: Vec::new(),
+        };
+        // Shared geometry is one `Arc`: its address names it.
+        let mut seen: Vec<*const Geometry> = Vec::new();
+        for (o, object) in scene.objects.iter().enumerate() {
+            match &object.geometry {
+                Geometry::Instance(i) => {
+                    let key = std::sync::Arc::as_ptr(&i.geometry);
+                    let k = seen.iter().position(|&s| s == key).unwrap_or_else(|| {
+                        seen.push(key);
+                        split.prototypes.push(&i.geometry);
+                        seen.len() - 1
+                    });
+                    split.instances.push((o as u32, k as u32, i.transform));
+                }
+                g => split.own.push((o as u32, g)),
+            }
+        }
+        split
+    }
+
+    /// Each shared geometry prepared in object space with its own BVH.
+    fn prepare_prototypes(&self) -> Vec<SceneGeometry> {
+        self.prototypes
+            .iter()
+            .map(|g| SceneGeometry::build_own(&[(0, g)], &[], Vec::new(), &ProgressBar::hidden()))
+            .collect()
+    }
 }
 
 impl SceneGeometry {
-    /// Prepares the patches and builds the BVH.
+    /// Prepares the patches and builds the BVH, with instances under a top-level BVH.
     pub fn build(scene: &Scene) -> SceneGeometry {
         Self::build_with(scene, &ProgressBar::hidden())
     }
 
-    /// [`build`](Self::build), advancing `progress` to twice the primitive count: one step
-    /// per primitive bounded (a trimmed patch's box is the costly part), one per primitive
-    /// placed in a BVH leaf.
+    /// [`build`](Self::build), advancing `progress` to twice the top-level primitive
+    /// count: one step per primitive bounded (a trimmed patch's box is the costly part),
+    /// one per primitive placed in a BVH leaf. Instances count as one primitive each.
     pub fn build_with(scene: &Scene, progress: &ProgressBar) -> SceneGeometry {
-        let patches = collect_patches(scene);
-        let triangles = collect_triangles(scene);
-        let primitives = patches.originals.len() + triangles.corners.len();
+        let split = Split::of(scene);
+        let prototypes = split.prepare_prototypes();
+        SceneGeometry::build_own(&split.own, &split.instances, prototypes, progress)
+    }
+
+    /// The BVH over `own`'s primitives and the boxes of the instances `placed` (object,
+    /// prototype, transform).
+    fn build_own(
+        own: &[(u32, &Geometry)],
+        placed: &[(u32, u32, glam::DAffine3)],
+        prototypes: Vec<SceneGeometry>,
+        progress: &ProgressBar,
+    ) -> SceneGeometry {
+        let patches = collect_patches(own);
+        let triangles = collect_triangles(own);
+        let instances = place(placed, &prototypes, patches.originals.len());
+        let primitives = patches.originals.len() + triangles.corners.len() + instances.len();
         progress.set_length(2 * primitives as u64);
         let mut bounded = Batched::new(progress);
         let boxes: Vec<Aabb> = patches
@@ -268,24 +339,45 @@ impl SceneGeometry {
                     .iter()
                     .map(|c| c.iter().copied().collect()),
             )
+            .chain(instances.iter().map(|i| i.bounds))
             .collect();
-        bounded.add(triangles.corners.len() as u64);
+        bounded.add((triangles.corners.len() + instances.len()) as u64);
         drop(bounded);
         let bvh = Bvh::build_packed_with(&boxes, patches.originals.len(), progress);
         let accel = Accel::bvh(bvh, patches.originals.len(), &triangles);
-        Self::with_accel(patches, triangles, accel)
+        Self::with_accel(patches, triangles, accel, instances, prototypes)
     }
 
     /// Prepares the patches and builds the uniform grid of LG90 §3.1 within `budget_bytes`
     /// (see [`Grid::build`]).
+    /// LG90's grid has no instances: they are prepared as placed copies.
     pub fn build_grid(scene: &Scene, budget_bytes: usize) -> SceneGeometry {
-        let patches = collect_patches(scene);
-        let triangles = collect_triangles(scene);
+        let resolved: Vec<(u32, Cow<Geometry>)> = scene
+            .objects
+            .iter()
+            .enumerate()
+            .map(|(o, object)| (o as u32, object.geometry.resolved()))
+            .collect();
+        let own: Vec<(u32, &Geometry)> = resolved.iter().map(|(o, g)| (*o, g.as_ref())).collect();
+        let patches = collect_patches(&own);
+        let triangles = collect_triangles(&own);
         let grid = Grid::build(&patches.originals, &triangles.corners, budget_bytes);
-        Self::with_accel(patches, triangles, Accel::Grid(grid))
+        Self::with_accel(
+            patches,
+            triangles,
+            Accel::Grid(grid),
+            Vec::new(),
+            Vec::new(),
+        )
     }
 
-    fn with_accel(patches: Patches, triangles: Triangles, accel: Accel) -> SceneGeometry {
+    fn with_accel(
+        patches: Patches,
+        triangles: Triangles,
+        accel: Accel,
+        instances: Vec<Placement>,
+        prototypes: Vec<SceneGeometry>,
+    ) -> SceneGeometry {
         let prepared = patches.originals.iter().map(PreparedPatch::new).collect();
         SceneGeometry {
             prepared,
@@ -294,13 +386,21 @@ impl SceneGeometry {
             trims: patches.trims,
             triangles,
             accel,
+            instances,
+            prototypes,
         }
     }
 
     /// A hash of the geometry the BVH indexes: degrees and control points in file order,
-    /// then triangle corners. A BVH file records it so that a stale file is refused.
+    /// then triangle corners, then the instances' boxes. A BVH file records it so that a
+    /// stale file is refused.
     pub fn geometry_hash(&self) -> u64 {
-        hash_geometry(&self.originals, &self.triangles)
+        hash_geometry(
+            &self.originals,
+            &self.triangles,
+            &self.instances,
+            &self.prototypes,
+        )
     }
 
     /// The BVH, when the geometry was prepared with one.
@@ -319,8 +419,38 @@ impl SceneGeometry {
         }
     }
 
+    /// The patches of the scene, each instance's counted.
     pub fn patch_count(&self) -> usize {
+        let instanced: usize = self
+            .instances
+            .iter()
+            .map(|i| self.prototypes[i.prototype as usize].patch_count())
+            .sum();
+        self.prepared.len() + instanced
+    }
+
+    /// The patches prepared in memory: those instances share, once.
+    pub fn prepared_patch_count(&self) -> usize {
         self.prepared.len()
+            + self
+                .prototypes
+                .iter()
+                .map(|p| p.prepared.len())
+                .sum::<usize>()
+    }
+
+    /// Points whose convex hull holds the surface of the scene's own patches and
+    /// triangles: control points and corners.
+    pub(super) fn hull_points(&self) -> impl Iterator<Item = DVec3> + '_ {
+        let corners = self.triangles.corners.iter().flatten();
+        self.originals
+            .iter()
+            .flat_map(|p| p.euclidean_points())
+            .chain(corners.map(|c| c.as_dvec3()))
+    }
+
+    pub fn instance_count(&self) -> usize {
+        self.instances.len()
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -379,14 +509,51 @@ impl SceneGeometry {
                 self.finish_patch_hit(prim, h.t() as f64, u, v, hit_box)
             }
             Candidate::Triangle(k, h) => self.finish_triangle_hit(k, &h),
+            Candidate::Instance(i, h) => self.instances[i as usize].hit_to_world(*h),
         })
     }
 
     /// The `f64` reference: every patch whose box the ray meets (an `f64` slab test, so no
     /// `f32` rounding of the ray can drop a candidate) is intersected in `f64`. Triangles
     /// are flat already; they are intersected by the watertight kernel on the ray rounded
-    /// to `f32`.
+    /// to `f32`. Instances whose box the ray meets take the ray mapped into object space
+    /// in `f64`, with no rounding to `f32`.
     pub fn intersect_f64(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+        tmin: f64,
+        tmax: f64,
+        cfg: &SubdivisionConfig,
+        stats: &mut QueryStats,
+    ) -> Option<SceneHit> {
+        let mut best = self.nearest_own_f64(origin, dir, tmin, tmax, cfg, stats);
+        let inv = dir.recip();
+        for placement in &self.instances {
+            let limit = best.as_ref().map_or(tmax, |h| h.t);
+            stats.bvh_box_tests += 1;
+            let b = &placement.bounds;
+            let b = DAabb {
+                min: b.min.as_dvec3(),
+                max: b.max.as_dvec3(),
+            };
+            if b.intersect(origin, inv, tmin, limit).is_none() {
+                continue;
+            }
+            let prototype = &self.prototypes[placement.prototype as usize];
+            let (o, d) = (
+                placement.point_to_object(origin),
+                placement.vector_to_object(dir),
+            );
+            if let Some(h) = prototype.intersect_f64(o, d, tmin, limit, cfg, stats) {
+                best = Some(placement.hit_to_world(h));
+            }
+        }
+        best
+    }
+
+    /// [`SceneGeometry::intersect_f64`] over the scene's own patches and triangles.
+    fn nearest_own_f64(
         &self,
         origin: DVec3,
         dir: DVec3,
@@ -466,11 +633,27 @@ impl SceneGeometry {
         // Made at the first leaf: most rays that miss never reach one.
         let mut shear = None;
         let patches = self.prepared.len() as u32;
+        let first_instance = patches + self.triangles.corners.len() as u32;
         let mut surface_tests = 0;
+        // Instances' work, counted apart from `kernel`, which the closure holds.
+        let mut nested = QueryStats::default();
         let t = bvh.traverse_leaves(ray, |range, tmax| {
             surface_tests += range.len() as u64;
-            if patches > 0 {
+            if patches > 0 || !self.instances.is_empty() {
                 for &prim in &bvh.prim_indices()[range.clone()] {
+                    if prim >= first_instance {
+                        let k = prim - first_instance;
+                        let r = Ray {
+                            tmax: *tmax,
+                            ..*ray
+                        };
+                        let (prototype, r, local) = self.enter_instance(k, &r, precision);
+                        if let Some(h) = prototype.intersect(&r, &local, &mut nested) {
+                            *tmax = tmax.min(h.t as f32);
+                            best = Some(Candidate::Instance(k, Box::new(h)));
+                        }
+                        continue;
+                    }
                     if prim >= patches {
                         continue;
                     }
@@ -496,10 +679,25 @@ impl SceneGeometry {
             }
             ControlFlow::Continue(())
         });
+        stats.add(&nested);
         stats.nodes_visited += t.nodes_visited;
         stats.bvh_box_tests += t.box_tests;
         stats.surface_tests += surface_tests;
         best
+    }
+
+    /// What instance `k` is queried with for `ray`: its shared geometry, the ray in
+    /// object space and the precision for it.
+    fn enter_instance(
+        &self,
+        k: u32,
+        ray: &Ray,
+        precision: &Precision,
+    ) -> (&SceneGeometry, Ray, Precision) {
+        let placement = &self.instances[k as usize];
+        let prototype = &self.prototypes[placement.prototype as usize];
+        let local = placement.precision_in_object(precision, prototype.prepared.len() as u32);
+        (prototype, placement.ray_to_object(ray), local)
     }
 
     /// Whether anything in the BVH blocks `ray`.
@@ -513,14 +711,22 @@ impl SceneGeometry {
     ) -> bool {
         let shear = PackShear::new(&RayShear::new(ray));
         let patches = self.prepared.len() as u32;
+        let first_instance = patches + self.triangles.corners.len() as u32;
         let kernel = &mut stats.kernel;
+        let mut nested = QueryStats::default();
         let mut patch_ray = PatchRay::new(ray);
         let mut hit = false;
         let mut surface_tests = 0;
         let t = bvh.traverse_leaves(ray, |range, _| {
             surface_tests += range.len() as u64;
             hit = bvh.prim_indices()[range.clone()].iter().any(|&prim| {
-                prim < patches && self.patch_occluded(prim, &mut patch_ray, precision, kernel)
+                if prim >= first_instance {
+                    let (prototype, r, local) =
+                        self.enter_instance(prim - first_instance, ray, precision);
+                    prototype.occluded(&r, &local, &mut nested)
+                } else {
+                    prim < patches && self.patch_occluded(prim, &mut patch_ray, precision, kernel)
+                }
             }) || packs.of_leaf(&range).1.iter().any(|pack| {
                 kernel.patch_tests += 1;
                 intersect_pack(&shear, pack, ray.tmin, ray.tmax).mask != 0
@@ -531,6 +737,7 @@ impl SceneGeometry {
                 ControlFlow::Continue(())
             }
         });
+        stats.add(&nested);
         stats.nodes_visited += t.nodes_visited;
         stats.bvh_box_tests += t.box_tests;
         stats.surface_tests += surface_tests;
@@ -709,6 +916,26 @@ impl SceneGeometry {
     }
 }
 
+/// The placements of the instances `placed` (object, prototype, transform), leaving out
+/// any whose transform has no inverse. Their patches are numbered after the scene's own
+/// `own_patches`, a run per instance, so a hit names its surface of origin uniquely.
+fn place(
+    placed: &[(u32, u32, glam::DAffine3)],
+    prototypes: &[SceneGeometry],
+    own_patches: usize,
+) -> Vec<Placement> {
+    let mut first = own_patches as u64;
+    placed
+        .iter()
+        .filter_map(|&(object, k, to_world)| {
+            let prototype = &prototypes[k as usize];
+            let number = u32::try_from(first).ok();
+            first += prototype.prepared.len() as u64;
+            Placement::new(k, object, prototype, to_world, number)
+        })
+        .collect()
+}
+
 /// The scene's patches as the accelerator indexes them.
 struct Patches {
     originals: Vec<BezierPatch>,
@@ -723,20 +950,20 @@ struct Patches {
 /// ray hits them exactly, while rounding would let the `f32` kernel report hits on them
 /// whose secondary rays, lacking a normal to leave along, re-hit the same curve (issue 7).
 /// So are patches their trim loops cut away wholly (culling, issue 15).
-fn collect_patches(scene: &Scene) -> Patches {
+fn collect_patches(objects: &[(u32, &Geometry)]) -> Patches {
     let mut out = Patches {
         originals: Vec::new(),
         ids: Vec::new(),
         trims: Vec::new(),
     };
-    for (o, object) in scene.objects.iter().enumerate() {
-        for (k, entry) in object.trimmed_patches().into_iter().enumerate() {
+    for &(o, geometry) in objects {
+        for (k, entry) in geometry.trimmed_patches().into_iter().enumerate() {
             let Some((p, trim)) = entry else { continue };
             if p.has_zero_area() {
                 continue;
             }
             out.originals.push(p);
-            out.ids.push((o as u32, k as u32));
+            out.ids.push((o, k as u32));
             out.trims.push(trim);
         }
     }
@@ -753,18 +980,24 @@ impl SceneGeometry {
         use crate::scene::LoadError;
         let file = std::fs::File::open(path).map_err(|e| LoadError::io(path, e))?;
         let mut reader = std::io::BufReader::new(file);
-        let patches = collect_patches(scene);
-        let triangles = collect_triangles(scene);
-        let bvh = Bvh::read(&mut reader, hash_geometry(&patches.originals, &triangles))
-            .map_err(|e| LoadError::invalid(path, e.to_string()))?;
-        if bvh.prim_count() != patches.originals.len() + triangles.corners.len() {
+        let split = Split::of(scene);
+        let prototypes = split.prepare_prototypes();
+        let patches = collect_patches(&split.own);
+        let triangles = collect_triangles(&split.own);
+        let instances = place(&split.instances, &prototypes, patches.originals.len());
+        let hash = hash_geometry(&patches.originals, &triangles, &instances, &prototypes);
+        let bvh =
+            Bvh::read(&mut reader, hash).map_err(|e| LoadError::invalid(path, e.to_string()))?;
+        if bvh.prim_count() != patches.originals.len() + triangles.corners.len() + instances.len() {
             return Err(LoadError::invalid(
                 path,
                 "the BVH indexes a different number of patches than the scene; rebuild it with `patchtrace bvh`",
             ));
         }
         let accel = Accel::bvh(bvh, patches.originals.len(), &triangles);
-        Ok(Self::with_accel(patches, triangles, accel))
+        Ok(Self::with_accel(
+            patches, triangles, accel, instances, prototypes,
+        ))
     }
 
     /// Writes the BVH with the scene's geometry hash, atomically; refused for a grid.
@@ -781,8 +1014,14 @@ impl SceneGeometry {
 }
 
 /// The hash a BVH file records: triangle corners, then degrees and control points in file
-/// order, so that a file built for other geometry is refused as stale.
-fn hash_geometry(patches: &[BezierPatch], triangles: &Triangles) -> u64 {
+/// order, then (for a scene with instances) each instance's placement and each shared
+/// geometry's own hash, so that a file built for other geometry is refused as stale.
+fn hash_geometry(
+    patches: &[BezierPatch],
+    triangles: &Triangles,
+    instances: &[Placement],
+    prototypes: &[SceneGeometry],
+) -> u64 {
     let mut h = GeometryHasher::new();
     h.write_u64(triangles.corners.len() as u64);
     for c in triangles.corners.iter().flatten() {
@@ -799,6 +1038,13 @@ fn hash_geometry(patches: &[BezierPatch], triangles: &Triangles) -> u64 {
                 h.write_f64(c);
             }
         }
+    }
+    if !instances.is_empty() {
+        h.write_u64(instances.len() as u64);
+        instances.iter().for_each(|i| i.hash_into(&mut h));
+        prototypes
+            .iter()
+            .for_each(|p| h.write_u64(p.geometry_hash()));
     }
     h.finish()
 }
@@ -834,11 +1080,11 @@ fn surviving_box(p: &BezierPatch, trim: Option<&PatchTrim>) -> DAabb {
     if kept.is_empty() { p.tight_box() } else { kept }
 }
 
-/// All mesh triangles of the scene in object order, rounded to `f32`.
-fn collect_triangles(scene: &Scene) -> Triangles {
+/// All mesh triangles of `objects` in order, rounded to `f32`.
+fn collect_triangles(objects: &[(u32, &Geometry)]) -> Triangles {
     let mut t = Triangles::default();
-    for (o, object) in scene.objects.iter().enumerate() {
-        let Geometry::Mesh(mesh) = &object.geometry else {
+    for &(o, geometry) in objects {
+        let Geometry::Mesh(mesh) = geometry else {
             continue;
         };
         let has_normals = mesh.normals.len() == mesh.positions.len();
@@ -847,7 +1093,7 @@ fn collect_triangles(scene: &Scene) -> Triangles {
             t.corners.push([a.as_vec3(), b.as_vec3(), c.as_vec3()]);
             t.normals
                 .push(has_normals.then(|| idx.map(|i| mesh.normals[i as usize])));
-            t.ids.push((o as u32, k as u32));
+            t.ids.push((o, k as u32));
         }
     }
     t

@@ -143,6 +143,10 @@ pub struct TeapotsArgs {
     /// Image height.
     #[arg(long, default_value_t = 512)]
     pub height: u32,
+    /// Give every teapot its own copy of the geometry instead of making the others
+    /// instances of the first (Dammertz §3.3): a scene of distinct patches.
+    #[arg(long)]
+    pub flatten: bool,
     /// Output scene (.ron).
     #[arg(short, long)]
     pub output: PathBuf,

@@ -26,6 +26,7 @@ pub fn teapots(args: TeapotsArgs) -> anyhow::Result<ExitCode> {
         lights: args.lights,
         width: args.width,
         height: args.height,
+        flatten: args.flatten,
     };
     let bpt = args.output.with_file_name("teapot.bpt");
     if !bpt.exists() {

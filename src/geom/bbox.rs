@@ -137,6 +137,11 @@ pub struct DAabb {
     pub max: DVec3,
 }
 
+/// Relative bound on the rounding of an affine map of a point in `f64`: 4 u for the three
+/// products and the translation of each coordinate (Higham 2002 §3.1, γ₄ with u = 2⁻⁵³),
+/// doubled so the sum of the magnitudes it multiplies, itself rounded, stays covered.
+pub const AFFINE_ROUNDING: f64 = 8.0 * (f64::EPSILON / 2.0);
+
 impl DAabb {
     pub const EMPTY: DAabb = DAabb {
         min: DVec3::splat(f64::INFINITY),
@@ -184,6 +189,46 @@ impl DAabb {
         let t_enter = near.max_element().max(tmin);
         let t_exit = far.min_element().min(tmax);
         (t_enter <= t_exit).then_some((t_enter, t_exit))
+    }
+
+    /// The box of this box's image under `m`: its eight corners mapped in `f64`, each
+    /// grown by a bound on the rounding of that map ([`AFFINE_ROUNDING`] times the sum of
+    /// the terms' magnitudes, Higham 2002 §3.1: a dot product of length 4 rounds by at
+    /// most 4u of it), so the result holds the exact image of every point of the box.
+    /// Empty stays empty.
+    pub fn transformed(&self, m: &glam::DAffine3) -> DAabb {
+        if self.is_empty() {
+            return DAabb::EMPTY;
+        }
+        DAabb::of_mapped_points(
+            (0..8).map(|k| {
+                let pick = |bit: usize, lo: f64, hi: f64| if k & bit == 0 { lo } else { hi };
+                DVec3::new(
+                    pick(1, self.min.x, self.max.x),
+                    pick(2, self.min.y, self.max.y),
+                    pick(4, self.min.z, self.max.z),
+                )
+            }),
+            m,
+        )
+    }
+
+    /// The box of `points` mapped by `m` in `f64`, each grown by the bound on the map's
+    /// rounding of [`DAabb::transformed`]: it holds their exact images.
+    pub fn of_mapped_points(points: impl IntoIterator<Item = DVec3>, m: &glam::DAffine3) -> DAabb {
+        let abs = glam::DMat3::from_cols(
+            m.matrix3.x_axis.abs(),
+            m.matrix3.y_axis.abs(),
+            m.matrix3.z_axis.abs(),
+        );
+        let mut out = DAabb::EMPTY;
+        for c in points {
+            let p = m.transform_point3(c);
+            let err = (abs * c.abs() + m.translation.abs()) * AFFINE_ROUNDING;
+            out.grow(p - err);
+            out.grow(p + err);
+        }
+        out
     }
 
     /// Length of the diagonal (0 for a point, NaN never: empty boxes give 0).

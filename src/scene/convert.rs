@@ -36,6 +36,10 @@ pub fn convert_scene(scene: &Scene) -> (Scene, ConversionReport) {
     let mut report = ConversionReport::default();
     let mut out = scene.clone();
     for object in &mut out.objects {
+        // An instance's shared surfaces are converted in its placed copy.
+        if let Geometry::Instance(i) = &object.geometry {
+            object.geometry = i.flattened();
+        }
         let Geometry::Surfaces(surfaces) = &mut object.geometry else {
             continue;
         };

@@ -54,12 +54,16 @@ pub struct TeapotsSpec {
     pub lights: usize,
     pub width: u32,
     pub height: u32,
+    /// Write every teapot as its own copy of the file instead of as an instance of the
+    /// first (`scene teapots --flatten`): a scene of distinct patches.
+    pub flatten: bool,
 }
 
 /// RON text of a scene with `count` teapots scattered in a cube (side grows with the cube
 /// root of the count, so density stays constant), each randomly rotated and scaled,
 /// referencing `teapot.bpt` beside the scene. One teapot is placed upright at the origin,
-/// filling the view, as in LG90's first test case.
+/// filling the view, as in LG90's first test case. The first teapot reads the file and the
+/// others are instances of it (Dammertz §3.3), unless `spec.flatten`.
 pub fn teapots_scene(spec: &TeapotsSpec) -> String {
     let mut rng = SplitMix64::new(spec.seed);
     let side = 8.0 * (spec.count.max(1) as f64).cbrt();
@@ -86,8 +90,13 @@ pub fn teapots_scene(spec: &TeapotsSpec) -> String {
                 axis.x, axis.y, axis.z, p.x, p.y, p.z
             )
         };
+        let geometry = if i == 0 || spec.flatten {
+            "File(\"teapot.bpt\")"
+        } else {
+            "Instance(of: \"teapot0\")"
+        };
         objects.push_str(&format!(
-            "        (name: \"teapot{i}\", geometry: File(\"teapot.bpt\"), material: \"{material}\", transform: {transform}),\n"
+            "        (name: \"teapot{i}\", geometry: {geometry}, material: \"{material}\", transform: {transform}),\n"
         ));
     }
     let mut lights = String::new();
@@ -133,6 +142,7 @@ mod tests {
             lights: 6,
             width: 64,
             height: 64,
+            flatten: false,
         };
         assert_eq!(teapots_scene(&spec), teapots_scene(&spec));
         assert_ne!(

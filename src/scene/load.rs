@@ -190,10 +190,7 @@ pub fn load_scene_noted(
 /// the object and surface.
 pub fn check_trims(path: &Path, scene: &Scene) -> Result<(), LoadError> {
     for o in &scene.objects {
-        let Geometry::Surfaces(surfaces) = &o.geometry else {
-            continue;
-        };
-        for (k, s) in surfaces.iter().enumerate() {
+        for (k, s) in o.geometry.surfaces().iter().enumerate() {
             if let Err(e) = s.trim_region() {
                 return Err(LoadError::invalid(
                     path,

@@ -1,7 +1,10 @@
 //! The in-memory scene: camera, lights, materials and objects. Geometry is kept in `f64`
 //! exactly as read (after transforms); the renderer rounds it to `f32` once.
 
-use glam::{DVec3, Vec3};
+use std::borrow::Cow;
+use std::sync::Arc;
+
+use glam::{DAffine3, DVec3, Vec3};
 
 use crate::geom::BezierPatch;
 use crate::geom::bbox::DAabb;
@@ -201,31 +204,69 @@ pub enum Geometry {
     /// (Dammertz §2.9); its patches are numbered as [`SubdivisionSurface::patches`], and
     /// `trace` reports the quad after the first step instead ([`Object::trace_patch`]).
     Subdivision(SubdivisionSurface),
+    /// Shared geometry placed by a transform (Dammertz §3.3).
+    Instance(Instance),
+}
+
+/// One placement of shared geometry (Dammertz §3.3): the geometry in its own (object)
+/// space and the affine map from there to world space. Objects holding the same `Arc`
+/// share one prepared copy and one bottom-level BVH when rendered
+/// ([`crate::accel::scene::SceneGeometry`]); everything else sees the placed copy
+/// ([`Geometry::resolved`]). The shape IGES 408 and STEP assembly occurrences map onto:
+/// a geometry and an affine transform. Never nested: [`Instance::new`] composes an instance
+/// of an instance into one of the base geometry.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Instance {
+    pub geometry: Arc<Geometry>,
+    /// Object space to world space.
+    pub transform: DAffine3,
+}
+
+impl Instance {
+    pub fn new(geometry: Arc<Geometry>, transform: DAffine3) -> Instance {
+        match geometry.as_ref() {
+            Geometry::Instance(inner) => Instance {
+                geometry: inner.geometry.clone(),
+                transform: transform * inner.transform,
+            },
+            _ => Instance {
+                geometry,
+                transform,
+            },
+        }
+    }
+
+    /// A copy of the geometry placed in world space: what the instance stands for.
+    pub fn flattened(&self) -> Geometry {
+        let mut g = (*self.geometry).clone();
+        g.transform(&self.transform);
+        g
+    }
 }
 
 impl Geometry {
-    pub fn transform(&mut self, m: &glam::DAffine3) {
+    pub fn transform(&mut self, m: &DAffine3) {
         match self {
             Geometry::Surfaces(s) => s.iter_mut().for_each(|s| s.transform(m)),
             Geometry::Mesh(mesh) => mesh.transform(m),
             Geometry::Subdivision(s) => s.transform(m),
+            Geometry::Instance(i) => i.transform = *m * i.transform,
         }
     }
-}
 
-#[derive(Clone, Debug, PartialEq)]
-pub struct Object {
-    pub name: String,
-    /// Index into [`Scene::materials`].
-    pub material: usize,
-    pub geometry: Geometry,
-}
+    /// The geometry in world space: an instance as its placed copy, anything else as is.
+    /// Never an [`Geometry::Instance`].
+    pub fn resolved(&self) -> Cow<'_, Geometry> {
+        match self {
+            Geometry::Instance(i) => Cow::Owned(i.flattened()),
+            other => Cow::Borrowed(other),
+        }
+    }
 
-impl Object {
-    /// The object's Bézier patches in contract order: file order, with each NURBS surface
-    /// expanded into its patches in span order, u spans fastest.
+    /// The geometry's Bézier patches in contract order: file order, with each NURBS
+    /// surface expanded into its patches in span order, u spans fastest.
     pub fn bezier_patches(&self) -> Vec<BezierPatch> {
-        match &self.geometry {
+        match self {
             Geometry::Surfaces(surfaces) => surfaces
                 .iter()
                 .flat_map(|s| match &s.geometry {
@@ -235,25 +276,23 @@ impl Object {
                 .collect(),
             Geometry::Mesh(_) => Vec::new(),
             Geometry::Subdivision(s) => s.patches.clone(),
+            Geometry::Instance(i) => i.flattened().bezier_patches(),
         }
     }
 
-    /// The patch number and `(u, v)` that `trace` reports for a hit at `(u, v)` on patch
-    /// `patch` (contract order): for a subdivision surface the quad after the first
-    /// Catmull–Clark step and its parameters (see [`crate::geom::subdiv`]), otherwise
-    /// unchanged.
-    pub fn trace_patch(&self, patch: u32, u: f64, v: f64) -> (u32, f64, f64) {
-        match &self.geometry {
-            Geometry::Subdivision(s) => s.face_uv(patch as usize, u, v).unwrap_or((patch, u, v)),
-            _ => (patch, u, v),
+    /// The number of [`Geometry::bezier_patches`], without placing an instance's copy.
+    pub fn patch_count(&self) -> usize {
+        match self {
+            Geometry::Instance(i) => i.geometry.patch_count(),
+            other => other.bezier_patches().len(),
         }
     }
 
-    /// The object's patches in contract order with their trims; `None` for a patch its
-    /// trim loops cut away wholly (it keeps its number, as the contract numbers patches in
-    /// file order).
+    /// The patches in contract order with their trims; `None` for a patch its trim loops
+    /// cut away wholly (it keeps its number, as the contract numbers patches in file
+    /// order).
     pub fn trimmed_patches(&self) -> Vec<Option<TrimmedPatch>> {
-        match &self.geometry {
+        match self {
             Geometry::Surfaces(surfaces) => surfaces
                 .iter()
                 .flat_map(|s| s.trimmed_patches())
@@ -265,11 +304,12 @@ impl Object {
                 .collect(),
             Geometry::Subdivision(s) => s.patches.iter().map(|p| Some((p.clone(), None))).collect(),
             Geometry::Mesh(_) => Vec::new(),
+            Geometry::Instance(i) => i.flattened().trimmed_patches(),
         }
     }
 
     pub fn bounds(&self) -> DAabb {
-        match &self.geometry {
+        match self {
             Geometry::Surfaces(surfaces) => surfaces
                 .iter()
                 .flat_map(|s| -> Vec<DVec3> {
@@ -284,7 +324,57 @@ impl Object {
             Geometry::Mesh(m) => m.positions.iter().copied().collect(),
             // The limit surface lies in the convex hull of the cage.
             Geometry::Subdivision(s) => s.cage.points.iter().copied().collect(),
+            // The placed corners of the shared geometry's box hold the placed geometry.
+            Geometry::Instance(i) => i.geometry.bounds().transformed(&i.transform),
         }
+    }
+
+    /// The free-form surfaces, an instance's unplaced.
+    pub fn surfaces(&self) -> &[Surface] {
+        match self {
+            Geometry::Surfaces(s) => s,
+            Geometry::Instance(i) => i.geometry.surfaces(),
+            Geometry::Mesh(_) | Geometry::Subdivision(_) => &[],
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Object {
+    pub name: String,
+    /// Index into [`Scene::materials`].
+    pub material: usize,
+    pub geometry: Geometry,
+}
+
+impl Object {
+    /// The object's Bézier patches in contract order ([`Geometry::bezier_patches`]).
+    pub fn bezier_patches(&self) -> Vec<BezierPatch> {
+        self.geometry.bezier_patches()
+    }
+
+    /// The patch number and `(u, v)` that `trace` reports for a hit at `(u, v)` on patch
+    /// `patch` (contract order): for a subdivision surface (an instance's too) the quad
+    /// after the first Catmull–Clark step and its parameters (see
+    /// [`crate::geom::subdiv`]), otherwise unchanged.
+    pub fn trace_patch(&self, patch: u32, u: f64, v: f64) -> (u32, f64, f64) {
+        let geometry = match &self.geometry {
+            Geometry::Instance(i) => i.geometry.as_ref(),
+            other => other,
+        };
+        match geometry {
+            Geometry::Subdivision(s) => s.face_uv(patch as usize, u, v).unwrap_or((patch, u, v)),
+            _ => (patch, u, v),
+        }
+    }
+
+    /// The object's patches with their trims ([`Geometry::trimmed_patches`]).
+    pub fn trimmed_patches(&self) -> Vec<Option<TrimmedPatch>> {
+        self.geometry.trimmed_patches()
+    }
+
+    pub fn bounds(&self) -> DAabb {
+        self.geometry.bounds()
     }
 }
 
@@ -430,7 +520,7 @@ impl Scene {
     }
 
     pub fn patch_count(&self) -> usize {
-        self.objects.iter().map(|o| o.bezier_patches().len()).sum()
+        self.objects.iter().map(|o| o.geometry.patch_count()).sum()
     }
 
     /// The number of trim loops over all surfaces.
@@ -441,11 +531,30 @@ impl Scene {
     /// The same scene with every trim loop removed (`--ignore-trims`: to see what trimming
     /// removes).
     pub fn without_trims(mut self) -> Scene {
+        fn strip(g: &mut Geometry) {
+            if let Geometry::Surfaces(surfaces) = g {
+                surfaces.iter_mut().for_each(|s| s.trims.clear());
+            }
+        }
+        // Each shared geometry once, so its instances keep sharing it.
+        let mut stripped: Vec<(*const Geometry, Arc<Geometry>)> = Vec::new();
         for o in &mut self.objects {
-            if let Geometry::Surfaces(surfaces) = &mut o.geometry {
-                for s in surfaces {
-                    s.trims.clear();
+            match &mut o.geometry {
+                Geometry::Instance(i) => {
+                    let key = Arc::as_ptr(&i.geometry);
+                    let shared = match stripped.iter().find(|(k, _)| *k == key) {
+                        Some((_, g)) => g.clone(),
+                        None => {
+                            let mut g = (*i.geometry).clone();
+                            strip(&mut g);
+                            let g = Arc::new(g);
+                            stripped.push((key, g.clone()));
+                            g
+                        }
+                    };
+                    i.geometry = shared;
                 }
+                g => strip(g),
             }
         }
         self
@@ -453,9 +562,6 @@ impl Scene {
 
     /// Every free-form surface of every object.
     pub fn surfaces(&self) -> impl Iterator<Item = &Surface> {
-        self.objects.iter().flat_map(|o| match &o.geometry {
-            Geometry::Surfaces(s) => s.as_slice(),
-            Geometry::Mesh(_) | Geometry::Subdivision(_) => &[],
-        })
+        self.objects.iter().flat_map(|o| o.geometry.surfaces())
     }
 }

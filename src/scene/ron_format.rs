@@ -3,6 +3,7 @@
 
 use std::collections::BTreeMap;
 use std::path::Path;
+use std::sync::Arc;
 
 use glam::{DAffine3, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
@@ -155,6 +156,10 @@ pub enum GeometryDef {
     /// A Catmull–Clark surface: `Subdivision(File("cage.obj"))`, a polygon mesh (OBJ or
     /// glTF) as the control cage, with sharp (`EDGE_ONLY`) boundaries.
     Subdivision(Box<GeometryDef>),
+    /// The geometry of the earlier object named `of`, as read (before that object's own
+    /// transform), placed by this object's `transform` (Dammertz §3.3). Every object that
+    /// instances the same geometry shares one copy of it when rendered.
+    Instance { of: String },
 }
 
 #[derive(Debug, Serialize, Deserialize)]
@@ -328,7 +333,16 @@ fn build_scene(path: &Path, at: &RonLocator, file: SceneFile) -> Result<Scene, L
         validate_material(m).map_err(|e| at.at_key(&m.name, e))?;
     }
     let base = path.parent().unwrap_or(Path::new("."));
-    let mut objects = Vec::with_capacity(file.objects.len());
+    // Names that instances refer to: those objects keep their geometry shared and unplaced.
+    let referenced_names: std::collections::HashSet<&str> = file
+        .objects
+        .iter()
+        .filter_map(|o| match &o.geometry {
+            GeometryDef::Instance { of } => Some(of.as_str()),
+            _ => None,
+        })
+        .collect();
+    let mut objects: Vec<Object> = Vec::with_capacity(file.objects.len());
     for (index, o) in file.objects.iter().enumerate() {
         let material = match &o.material {
             Some(name) => materials.iter().position(|m| &m.name == name).ok_or_else(|| {
@@ -342,6 +356,21 @@ fn build_scene(path: &Path, at: &RonLocator, file: SceneFile) -> Result<Scene, L
             }
         };
         let mut geometry = match &o.geometry {
+            GeometryDef::Instance { of } => {
+                let Some(Geometry::Instance(shared)) = objects
+                    .iter()
+                    .find(|earlier| &earlier.name == of)
+                    .map(|earlier| &earlier.geometry)
+                else {
+                    return Err(at
+                        .at_object(
+                            index,
+                            format!("object {index}: expected Instance(of: NAME) with the name of an earlier object, found \"{of}\""),
+                        )
+                        .into());
+                };
+                Geometry::Instance(Instance::new(shared.geometry.clone(), DAffine3::IDENTITY))
+            }
             GeometryDef::File(f) => {
                 super::load::load_geometry(&base.join(file_name(at, index, f)?))
                     .map_err(|e| referenced(at, index, f, e))?
@@ -375,10 +404,8 @@ fn build_scene(path: &Path, at: &RonLocator, file: SceneFile) -> Result<Scene, L
         };
         let stand = DAffine3::from_mat3(o.up.unwrap_or(Axis::Z).to_z_up());
         let m = o.transform.iter().fold(stand, |acc, t| t.to_affine() * acc);
-        if m != DAffine3::IDENTITY {
-            geometry.transform(&m);
-        }
         let name = o.name.clone().unwrap_or_else(|| match &o.geometry {
+            GeometryDef::Instance { of } => of.clone(),
             GeometryDef::File(f) => f.clone(),
             GeometryDef::Subdivision(inner) => match inner.as_ref() {
                 GeometryDef::File(f) => f.clone(),
@@ -386,6 +413,14 @@ fn build_scene(path: &Path, at: &RonLocator, file: SceneFile) -> Result<Scene, L
             },
             GeometryDef::Surfaces(_) => format!("object{index}"),
         });
+        // Geometry an instance refers to is kept unplaced and shared, this object being
+        // its first instance; any other is placed in world space now.
+        if referenced_names.contains(name.as_str()) && !matches!(geometry, Geometry::Instance(_)) {
+            geometry = Geometry::Instance(Instance::new(Arc::new(geometry), DAffine3::IDENTITY));
+        }
+        if m != DAffine3::IDENTITY {
+            geometry.transform(&m);
+        }
         objects.push(Object {
             name,
             material,
@@ -784,14 +819,16 @@ pub fn scene_to_file(scene: &Scene) -> Result<SceneFile, String> {
     let mut objects = Vec::new();
     for o in &scene.objects {
         let limit_patches: Vec<Surface>;
-        let surfaces = match &o.geometry {
+        // An instance is written as its placed copy.
+        let geometry = o.geometry.resolved();
+        let surfaces = match geometry.as_ref() {
             Geometry::Surfaces(s) => s,
             // Written as its limit surface's Bézier patches.
             Geometry::Subdivision(s) => {
                 limit_patches = s.patches.iter().cloned().map(Surface::bezier).collect();
                 &limit_patches
             }
-            Geometry::Mesh(_) => {
+            Geometry::Mesh(_) | Geometry::Instance(_) => {
                 return Err(format!(
                     "object \"{}\" is a triangle mesh; RON scenes reference meshes by file",
                     o.name

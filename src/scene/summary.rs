@@ -121,7 +121,9 @@ pub fn summarize(scene: &Scene) -> SceneSummary {
                 .or_insert(0) += 1;
             rational += p.is_rational() as usize;
         }
-        let (surfaces, n, trims, tris) = match &o.geometry {
+        // An instance is summarised as its placed copy.
+        let geometry = o.geometry.resolved();
+        let (surfaces, n, trims, tris) = match geometry.as_ref() {
             Geometry::Surfaces(s) => (
                 s.len(),
                 s.iter()
@@ -131,12 +133,12 @@ pub fn summarize(scene: &Scene) -> SceneSummary {
                 0,
             ),
             Geometry::Mesh(m) => (0, 0, 0, m.indices.len()),
-            Geometry::Subdivision(_) => (1, 0, 0, 0),
+            Geometry::Subdivision(_) | Geometry::Instance(_) => (1, 0, 0, 0),
         };
         patches += bez.len();
         nurbs += n;
         triangles += tris;
-        let subdivision = match &o.geometry {
+        let subdivision = match geometry.as_ref() {
             Geometry::Subdivision(sd) => Some(SubdivisionSummary {
                 cage_vertices: sd.cage.points.len(),
                 cage_faces: sd.stats.cage_faces,
@@ -161,14 +163,12 @@ pub fn summarize(scene: &Scene) -> SceneSummary {
             patches: bez.len(),
             trim_loops: trims,
             triangles: tris,
-            trimmed_surfaces: match &o.geometry {
-                Geometry::Surfaces(s) => s
-                    .iter()
-                    .enumerate()
-                    .filter_map(|(k, s)| trim_summary(k, s))
-                    .collect(),
-                Geometry::Mesh(_) | Geometry::Subdivision(_) => Vec::new(),
-            },
+            trimmed_surfaces: geometry
+                .surfaces()
+                .iter()
+                .enumerate()
+                .filter_map(|(k, s)| trim_summary(k, s))
+                .collect(),
         });
     }
     let b = scene.bounds();

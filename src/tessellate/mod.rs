@@ -209,7 +209,9 @@ fn object_within(
     patch_done: &mut dyn FnMut(),
 ) -> Result<(Object, TessellationReport, Vec<FaceBoundary>), TessellateError> {
     let mut boundaries = Vec::new();
-    let mesh = match &object.geometry {
+    // An instance is tessellated as its placed copy.
+    let geometry = object.geometry.resolved();
+    let mesh = match geometry.as_ref() {
         Geometry::Mesh(m) => m.clone(),
         Geometry::Surfaces(surfaces) => {
             let plan = Plan::new(mode)?;
@@ -235,7 +237,9 @@ fn object_within(
             }
             mesh
         }
-        Geometry::Subdivision(_) => tessellate_patches(&object.bezier_patches(), mode)?.mesh,
+        Geometry::Subdivision(_) | Geometry::Instance(_) => {
+            tessellate_patches(&geometry.bezier_patches(), mode)?.mesh
+        }
     };
     let report = TessellationReport::of(&mesh);
     Ok((

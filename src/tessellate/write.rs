@@ -50,7 +50,7 @@ pub fn write_mesh_scene(path: &Path, scene: &Scene) -> Result<u64, LoadError> {
     for o in &scene.objects {
         match &o.geometry {
             Geometry::Mesh(m) => meshes.push((o.name.as_str(), m)),
-            Geometry::Surfaces(_) | Geometry::Subdivision(_) => {
+            Geometry::Surfaces(_) | Geometry::Subdivision(_) | Geometry::Instance(_) => {
                 return Err(LoadError::invalid(
                     path,
                     format!(

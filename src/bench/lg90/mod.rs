@@ -216,6 +216,8 @@ pub fn write_case_scene(case: &Case, size: u32, dir: &Path) -> Result<PathBuf, L
         lights: case.lights,
         width: size,
         height: size,
+        // LG90's grid has no instances: each teapot its own copy, as in their tests.
+        flatten: true,
     };
     let path = dir.join(format!("lg90-case{}.ron", case.number));
     write_atomic(&path, |w| w.write_all(teapots_scene(&spec).as_bytes()))?;

@@ -15,7 +15,7 @@ use crate::geom::ulp::step_ulps;
 use crate::geom::{BezierPatch, Ray};
 use crate::scene::bpt::parse_bpt;
 use crate::scene::generate::{SplitMix64, TEAPOT_BPT};
-use crate::scene::{Geometry, Material, Object, Scene, Surface};
+use crate::scene::{Geometry, Instance, Material, Object, Scene, Surface};
 
 /// How many rays each case traces: the reduced set runs in `cargo test`, the full one in
 /// `patchtrace bench stability --full`.
@@ -190,6 +190,19 @@ pub fn all_cases(size: SuiteSize, seed: u64) -> Vec<Case> {
         &p,
         trim_grazing_rays(&p, n, &mut rng),
     ));
+    for (name, placements) in instance_placements() {
+        let rounded: Vec<BezierPatch> = teapot.iter().map(round_to_f32).collect();
+        let copies: Vec<BezierPatch> = placements
+            .iter()
+            .flat_map(|m| transformed(&rounded, *m))
+            .collect();
+        cases.push(instanced_case(
+            name,
+            &rounded,
+            &placements,
+            random_rays(&copies, n, &mut rng),
+        ));
+    }
     for s in [NEAR_SUBNORMAL_SCALE, SUBNORMAL_SCALE] {
         let p = transformed(&teapot, DAffine3::from_scale(DVec3::splat(s)));
         cases.push(case(
@@ -224,12 +237,72 @@ fn holed_case(name: &str, plate: &BezierPatch, rays: Vec<Ray>) -> Case {
     case_of_surfaces(name, vec![surface], rays)
 }
 
+/// Instances of the teapot (Dammertz §3.3) placed so that the transforms round: rotated
+/// about a skew axis and scaled, mirrored, stretched unevenly, and far from the origin
+/// at a large scale. Secondary rays leave each through the world leave box
+/// ([`crate::accel`]'s instance module) and re-enter their own instance rounded again.
+fn instance_placements() -> Vec<(&'static str, Vec<DAffine3>)> {
+    let skew = DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7);
+    let near = vec![
+        DAffine3::from_scale_rotation_translation(
+            DVec3::splat(0.7),
+            skew,
+            DVec3::new(3.0, 1.0, 0.0),
+        ),
+        DAffine3::from_scale(DVec3::new(-1.0, 1.0, 1.0)),
+        DAffine3::from_scale_rotation_translation(
+            DVec3::new(1.0, 2.0, 0.5),
+            skew.inverse(),
+            DVec3::new(-3.0, 0.5, 1.0),
+        ),
+    ];
+    let far = near
+        .iter()
+        .map(|m| {
+            DAffine3::from_translation(DVec3::splat(1e3))
+                * DAffine3::from_scale(DVec3::splat(1e2))
+                * *m
+        })
+        .collect();
+    vec![
+        ("teapot instances: rotated, mirrored, stretched", near),
+        ("teapot instances x1e2 at 1e3", far),
+    ]
+}
+
+/// A case of instances of `patches` (already in `f32`) placed by `placements`.
+fn instanced_case(
+    name: &str,
+    patches: &[BezierPatch],
+    placements: &[DAffine3],
+    rays: Vec<Ray>,
+) -> Case {
+    let shared = std::sync::Arc::new(Geometry::Surfaces(
+        patches.iter().cloned().map(Surface::bezier).collect(),
+    ));
+    let objects = placements
+        .iter()
+        .enumerate()
+        .map(|(k, m)| Object {
+            name: format!("{name} {k}"),
+            material: 0,
+            geometry: Geometry::Instance(Instance::new(shared.clone(), *m)),
+        })
+        .collect();
+    case_of_objects(name, objects, rays)
+}
+
 fn case_of_surfaces(name: &str, surfaces: Vec<Surface>, rays: Vec<Ray>) -> Case {
-    let mut scene = Scene::framing(vec![Object {
+    let object = Object {
         name: name.to_string(),
         material: 0,
         geometry: Geometry::Surfaces(surfaces),
-    }]);
+    };
+    case_of_objects(name, vec![object], rays)
+}
+
+fn case_of_objects(name: &str, objects: Vec<Object>, rays: Vec<Ray>) -> Case {
+    let mut scene = Scene::framing(objects);
     scene.materials[0] = Material {
         specular: 0.5,
         reflect: 0.3,

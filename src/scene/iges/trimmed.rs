@@ -434,6 +434,17 @@ fn analytic_with_loops(
     }
     let [u, v] = if trims.iter().any(|l| !l.hole) {
         let (lo, hi) = control_box(&trims);
+        for (k, periodic) in angular.iter().enumerate() {
+            // Loops within one turn have a control box a little wider at most; one over
+            // two turns is not in radians (OpenCASCADE writes these angles in degrees).
+            if *periodic && hi[k] - lo[k] > 2.0 * std::f64::consts::TAU {
+                return Err(format!(
+                    "the trim loops span {} in the angle {}, more than a turn: degrees? (IGES 5.3 gives radians)",
+                    hi[k] - lo[k],
+                    ["u", "v"][k]
+                ));
+            }
+        }
         [[lo.x, hi.x], [lo.y, hi.y]]
     } else {
         placed.closed_box().ok_or(
