@@ -3,7 +3,8 @@
 //! pcurve seam, a B-spline bottom with a hole) repeated side by side until the file
 //! reaches 5 MB, written to a temporary file at bench time (not committed), then read
 //! with `step::read_step` (file, Part 21 parse, entities, trim loops, exact NURBS).
-//! Median of several runs after a warm-up, wall and on-CPU time of the reading thread.
+//! Median of several runs after a warm-up, wall and on-CPU time of the whole process (the
+//! faces convert in parallel).
 //!
 //! `cargo bench --bench step_read`
 
@@ -17,10 +18,15 @@ use patchtrace::scene::step::{read_step, records};
 const RUNS: usize = 5;
 const TARGET_BYTES: usize = 5_000_000;
 
-/// Seconds this thread has run on a CPU (Linux schedstat), as in the other benches.
+/// Seconds all threads of this process have run on a CPU (user + system, Linux
+/// `/proc/self/stat`, in clock ticks of 1/100 s): faces convert on every core.
 fn cpu_seconds() -> Option<f64> {
-    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    Some(s.split_whitespace().next()?.parse::<f64>().ok()? * 1e-9)
+    let s = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name, which is in parentheses and may hold spaces.
+    let rest = &s[s.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -60,7 +66,7 @@ fn main() {
     }
     std::fs::remove_dir_all(&dir).ok();
     println!(
-        "step_read: {:.2} MB, {copies} parts, {faces} faces: read {:.3} s wall (median of {RUNS}, {:.3}..{:.3}), {} s on CPU; Part 21 parse alone {:.3} s",
+        "step_read: {:.2} MB, {copies} parts, {faces} faces: read {:.3} s wall (median of {RUNS}, {:.3}..{:.3}), {} s CPU (all threads); Part 21 parse alone {:.3} s",
         text.len() as f64 / 1e6,
         median(wall.clone()),
         wall.iter().cloned().fold(f64::INFINITY, f64::min),

@@ -201,6 +201,25 @@ fn an_empty_geometry_file_name_is_refused_at_the_object() {
     );
 }
 
+/// Bytes that are not UTF-8 in a text format are refused at their line and column (the
+/// message was "stream did not contain valid UTF-8", with no place), for every reader
+/// that takes text as UTF-8 (IGES and STEP locate a stray byte by their own syntax).
+#[test]
+fn bytes_that_are_not_utf8_are_located() {
+    let d = Dir::new();
+    for name in ["bad.bpt", "bad.obj", "bad.pbrt", "bad.ron"] {
+        let path = d.path(name);
+        std::fs::write(&path, b"1\n3 \xff 3\n").unwrap();
+        let err = refused(&run(&["info", s(&path)]));
+        assert!(
+            err.contains(&format!(
+                "{name}:2:3: expected UTF-8 text, found the byte 0xff"
+            )),
+            "{err}"
+        );
+    }
+}
+
 #[test]
 fn ron_value_checks_are_located() {
     let d = Dir::new();

@@ -133,15 +133,21 @@ fn frame(z: DVec3, x: DVec3) -> (DVec3, DVec3, DVec3) {
     (x, z.cross(x), z)
 }
 
-#[test]
-fn plane_face_matches_the_definition() {
+/// A plane through (1, 2, 3) with normal (1, 1, 1) and x along (1, −1, 0): its origin,
+/// axis, reference direction and its point at parameters (u, v) by ISO 10303-42.
+fn tilted_plane() -> (DVec3, DVec3, DVec3, impl Fn(f64, f64) -> DVec3) {
     let (o, zd, xd) = (
         DVec3::new(1.0, 2.0, 3.0),
         DVec3::ONE,
         DVec3::new(1.0, -1.0, 0.0),
     );
     let (x, y, _) = frame(zd, xd);
-    let at = |u: f64, v: f64| o + u * x + v * y;
+    (o, zd, xd, move |u: f64, v: f64| o + u * x + v * y)
+}
+
+#[test]
+fn plane_face_matches_the_definition() {
+    let (o, zd, xd, at) = tilted_plane();
     let mut w = StepWriter::default();
     let ax = w.axis(o, zd, xd);
     let plane = w.add(format!("PLANE('',#{ax})"));
@@ -156,6 +162,39 @@ fn plane_face_matches_the_definition() {
     assert_close(lo, DVec2::new(-1.0, 0.5), 1e-12, "domain low");
     assert_close(hi, DVec2::new(2.0, 1.5), 1e-12, "domain high");
     assert_eq!(s.trims.len(), 1);
+}
+
+/// A plane's edges map exactly through its frame: a circular hole (no pcurve) in a tilted
+/// plane becomes a rational loop whose every point lies at the circle's radius from its
+/// centre in the plane's parameters, to 1e-12 (a projected polyline's chords would fall
+/// inside by up to the chord tolerance).
+#[test]
+fn a_circle_on_a_plane_becomes_an_exact_rational_loop() {
+    let (o, zd, xd, at) = tilted_plane();
+    let (c, r) = (DVec2::new(0.5, 0.25), 0.75);
+    let mut w = StepWriter::default();
+    let ax = w.axis(o, zd, xd);
+    let plane = w.add(format!("PLANE('',#{ax})"));
+    let outer = w.polygon_bound(
+        &[at(-2.0, -2.0), at(2.0, -2.0), at(2.0, 2.0), at(-2.0, 2.0)],
+        true,
+    );
+    let hole = w.circle_bound(at(c.x, c.y), zd, DVec3::new(0.3, 0.7, -1.0), r, false);
+    w.face(&[outer, hole], plane);
+    let s = only_surface(&w.finish());
+    let hole = s.trims.iter().find(|l| l.hole).expect("the hole loop");
+    // Off the knots (a polyline's samples at its vertices would lie on the circle too).
+    let points = hole.segments.iter().flat_map(|seg| {
+        let c = as_curve(&seg.curve);
+        (0..997).map(move |k| {
+            c.eval(seg.t0 + (seg.t1 - seg.t0) * (k as f64 + 0.5) / 997.0)
+                .truncate()
+        })
+    });
+    for p in points {
+        let off = ((p - c).length() - r).abs();
+        assert!(off <= 1e-12, "a loop point {p} is {off} off the circle");
+    }
 }
 
 #[test]

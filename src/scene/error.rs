@@ -91,9 +91,23 @@ impl LoadError {
     }
 }
 
-/// Reads a whole text file, naming the path on failure.
+/// Reads a whole text file, naming the path on failure; bytes that are not UTF-8 are
+/// refused at their line and column.
 pub fn read_text(path: &Path) -> Result<String, LoadError> {
-    std::fs::read_to_string(path).map_err(|e| LoadError::io(path, e))
+    let bytes = std::fs::read(path).map_err(|e| LoadError::io(path, e))?;
+    String::from_utf8(bytes).map_err(|e| {
+        let good = e.utf8_error().valid_up_to();
+        let bytes = e.as_bytes();
+        let text = std::str::from_utf8(&bytes[..good]).unwrap_or_default();
+        let (line, column) = line_column(text, good);
+        ParseError::new(
+            path,
+            line,
+            column,
+            format!("expected UTF-8 text, found the byte 0x{:02x}", bytes[good]),
+        )
+        .into()
+    })
 }
 
 /// The 1-based line and column (in characters) of byte offset `byte` of `src`, for readers

@@ -44,6 +44,19 @@ pub fn mutation() -> impl Strategy<Value = Mutation> {
     ]
 }
 
+impl Mutation {
+    /// The mutation as a byte edit, for binary files: line and number edits become a flip
+    /// of one low bit at the same index.
+    pub fn bytewise(self) -> Mutation {
+        match self {
+            Mutation::DropLine(at)
+            | Mutation::RepeatLine(at)
+            | Mutation::ReplaceNumber { which: at, .. } => Mutation::FlipByte { at, bits: 1 },
+            m => m,
+        }
+    }
+}
+
 pub fn apply(src: &str, muts: &[Mutation]) -> String {
     String::from_utf8_lossy(&apply_bytes(src.as_bytes(), muts)).into_owned()
 }

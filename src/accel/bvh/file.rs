@@ -37,18 +37,19 @@ const NODE_WORDS: usize = size_of::<Node>() / 4;
 /// Why a BVH file was refused.
 #[derive(Debug, Error)]
 pub enum BvhFileError {
-    #[error("not a patchtrace BVH file (wrong magic number)")]
+    #[error("byte 0: not a patchtrace BVH file (wrong magic number)")]
     NotBvh,
     #[error(
-        "BVH file format version {found} is not supported (this build reads version {supported})"
+        "byte 8: BVH file format version {found} is not supported (this build reads version {supported})"
     )]
     UnsupportedVersion { found: u32, supported: u32 },
     #[error(
         "the BVH file was built for different geometry (geometry hash {found:016x}, scene has {expected:016x}); rebuild with `patchtrace bvh`"
     )]
     Stale { found: u64, expected: u64 },
-    #[error("the BVH file is truncated: it ends inside the {0}")]
-    Truncated(&'static str),
+    #[error("byte {at}: the BVH file is truncated: it ends inside the {what}")]
+    Truncated { what: &'static str, at: usize },
+    /// A count or checksum that cannot be right; the message starts with its byte offset.
     #[error("the BVH file is corrupt: {0}")]
     Corrupt(String),
     #[error("the BVH file has an invalid tree: {0}")]
@@ -87,9 +88,12 @@ impl Bvh {
             return Err(BvhFileError::NotBvh);
         }
         if header.len() < MAGIC.len() {
-            return Err(BvhFileError::Truncated("magic number"));
+            return Err(BvhFileError::Truncated {
+                what: "magic number",
+                at: header.len(),
+            });
         }
-        read_exactly(r, &mut header, HEADER_LEN - MAGIC.len(), "header")?;
+        read_exactly(r, &mut header, HEADER_LEN - MAGIC.len(), ("header", 0))?;
         let version = u32::from_le_bytes(field(&header, 8));
         if version != FORMAT_VERSION {
             return Err(BvhFileError::UnsupportedVersion {
@@ -104,7 +108,7 @@ impl Bvh {
         // keeps a corrupt count from asking for an absurd read.
         if prim_count > u64::from(u32::MAX) || node_count > (2 * prim_count).saturating_sub(1) {
             return Err(BvhFileError::Corrupt(format!(
-                "{node_count} nodes for {prim_count} primitives"
+                "byte 20: {node_count} nodes for {prim_count} primitives"
             )));
         }
         let (node_count, prim_count) = (node_count as usize, prim_count as usize);
@@ -113,17 +117,21 @@ impl Bvh {
             r,
             &mut data,
             4 * (NODE_WORDS * node_count + prim_count),
-            "tree data",
+            ("tree data", 0),
         )?;
         let mut stored = Vec::with_capacity(8);
-        read_exactly(r, &mut stored, 8, "checksum")?;
+        read_exactly(r, &mut stored, 8, ("checksum", data.len()))?;
         if u64::from_le_bytes(field(&stored, 0)) != checksum(&data) {
-            return Err(BvhFileError::Corrupt("checksum mismatch".into()));
+            return Err(BvhFileError::Corrupt(format!(
+                "byte {}: checksum mismatch",
+                data.len()
+            )));
         }
         if r.read(&mut [0u8; 1])? != 0 {
-            return Err(BvhFileError::Corrupt(
-                "extra bytes after the checksum".into(),
-            ));
+            return Err(BvhFileError::Corrupt(format!(
+                "byte {}: extra bytes after the checksum",
+                data.len() + 8
+            )));
         }
         if found_hash != expected_geometry_hash {
             return Err(BvhFileError::Stale {
@@ -150,18 +158,22 @@ fn checksum(bytes: &[u8]) -> u64 {
     h.finish()
 }
 
-/// Appends exactly `len` more bytes from `r` to `buf`. Reads through `take` so that a corrupt
-/// length can only make the buffer as big as the file really is.
+/// Appends exactly `len` more bytes from `r` to `buf`, which starts at byte `base` of the
+/// file (for the error's offset). Reads through `take` so that a corrupt length can only
+/// make the buffer as big as the file really is.
 fn read_exactly(
     r: &mut dyn Read,
     buf: &mut Vec<u8>,
     len: usize,
-    what: &'static str,
+    (what, base): (&'static str, usize),
 ) -> Result<(), BvhFileError> {
     let want = buf.len() + len;
     r.take(len as u64).read_to_end(buf)?;
     if buf.len() < want {
-        return Err(BvhFileError::Truncated(what));
+        return Err(BvhFileError::Truncated {
+            what,
+            at: base + buf.len(),
+        });
     }
     Ok(())
 }

@@ -7,7 +7,7 @@
 use std::cell::{Cell, RefCell};
 use std::collections::HashMap;
 use std::path::Path;
-use std::rc::Rc;
+use std::sync::Arc;
 
 use glam::{DVec3, DVec4};
 
@@ -37,7 +37,7 @@ pub enum Curve {
     /// The basis curve between two parameters (already in radians for conics);
     /// `sense` false runs it backwards.
     Trimmed {
-        basis: Rc<Curve>,
+        basis: Arc<Curve>,
         t0: f64,
         t1: f64,
         sense: bool,
@@ -45,7 +45,7 @@ pub enum Curve {
     /// SURFACE_CURVE / SEAM_CURVE: the 3D curve and its pcurves (a seam has two on the
     /// same surface).
     OnSurface {
-        curve: Rc<Curve>,
+        curve: Arc<Curve>,
         pcurves: Vec<PCurve>,
     },
 }
@@ -55,7 +55,7 @@ pub enum Curve {
 #[derive(Clone, Debug, PartialEq)]
 pub struct PCurve {
     pub surface: u64,
-    pub curve: Rc<Curve>,
+    pub curve: Arc<Curve>,
 }
 
 /// Surfaces with the parameterisations of ISO 10303-42 §4.4.?; angles in radians.
@@ -82,13 +82,13 @@ pub enum SurfaceDef {
     /// The profile rotated by u about the axis through `origin` along unit `axis`;
     /// v is the profile's parameter.
     Revolution {
-        profile: Rc<Curve>,
+        profile: Arc<Curve>,
         origin: DVec3,
         axis: DVec3,
     },
     /// `profile(u) + v · direction`.
     Extrusion {
-        profile: Rc<Curve>,
+        profile: Arc<Curve>,
         direction: DVec3,
     },
     /// B_SPLINE_SURFACE_WITH_KNOTS, BEZIER_SURFACE and their rational forms, as read.
@@ -100,7 +100,7 @@ pub enum SurfaceDef {
 pub struct Face {
     pub id: u64,
     pub surface_id: u64,
-    pub surface: Rc<SurfaceDef>,
+    pub surface: Arc<SurfaceDef>,
     pub same_sense: bool,
     pub bounds: Vec<Bound>,
 }
@@ -121,7 +121,7 @@ pub struct Bound {
 pub struct OrientedEdge {
     /// False: the loop traverses the edge from its end vertex to its start.
     pub orientation: bool,
-    pub edge: Rc<Edge>,
+    pub edge: Arc<Edge>,
 }
 
 /// EDGE_CURVE: from `start` to `end` along `curve` (against it when `same_sense` is false).
@@ -132,7 +132,7 @@ pub struct Edge {
     pub end: DVec3,
     /// The two vertices are one VERTEX_POINT: a closed edge (a full circle).
     pub closed: bool,
-    pub curve: Rc<Curve>,
+    pub curve: Arc<Curve>,
     pub same_sense: bool,
 }
 
@@ -143,9 +143,9 @@ pub struct Resolver<'e, 'a> {
     /// Radians per unit of plane angle in the file (1, or π/180 for degrees).
     pub angle_unit: f64,
     depth: Cell<usize>,
-    curves: RefCell<HashMap<u64, Rc<Curve>>>,
-    surfaces: RefCell<HashMap<u64, Rc<SurfaceDef>>>,
-    edges: RefCell<HashMap<u64, Rc<Edge>>>,
+    curves: RefCell<HashMap<u64, Arc<Curve>>>,
+    surfaces: RefCell<HashMap<u64, Arc<SurfaceDef>>>,
+    edges: RefCell<HashMap<u64, Arc<Edge>>>,
     /// The type of the last valid but unsupported entity met (an OFFSET_SURFACE under a
     /// face), which makes its face skipped rather than the file refused.
     unsupported: RefCell<Option<String>>,
@@ -506,28 +506,28 @@ impl<'e, 'a> Resolver<'e, 'a> {
     }
 
     /// Any supported curve (3D or, in a pcurve, 2D).
-    pub fn curve(&self, from: &Rec, i: usize) -> Result<Rc<Curve>, ParseError> {
+    pub fn curve(&self, from: &Rec, i: usize) -> Result<Arc<Curve>, ParseError> {
         let id = from.reference(i, "a curve")?;
         self.curve_by_id(from, id)
     }
 
-    pub fn curve_by_id(&self, from: &Rec, id: u64) -> Result<Rc<Curve>, ParseError> {
+    pub fn curve_by_id(&self, from: &Rec, id: u64) -> Result<Arc<Curve>, ParseError> {
         self.cached(&self.curves, from, id, |inst| self.read_curve(inst))
     }
 
     /// Entity `id` from `cache`, or read by `read` one level deeper and kept.
     fn cached<T>(
         &self,
-        cache: &RefCell<HashMap<u64, Rc<T>>>,
+        cache: &RefCell<HashMap<u64, Arc<T>>>,
         from: &Rec,
         id: u64,
         read: impl FnOnce(&'e Instance<'a>) -> Result<T, ParseError>,
-    ) -> Result<Rc<T>, ParseError> {
+    ) -> Result<Arc<T>, ParseError> {
         if let Some(c) = cache.borrow().get(&id) {
             return Ok(c.clone());
         }
         let inst = self.instance(from, id)?;
-        let c = Rc::new(self.deeper(from, || read(inst))?);
+        let c = Arc::new(self.deeper(from, || read(inst))?);
         cache.borrow_mut().insert(id, c.clone());
         Ok(c)
     }
@@ -715,7 +715,7 @@ impl<'e, 'a> Resolver<'e, 'a> {
     }
 
     /// Any supported surface, cached by id (faces share their surfaces with pcurves).
-    pub fn surface_by_id(&self, from: &Rec, id: u64) -> Result<Rc<SurfaceDef>, ParseError> {
+    pub fn surface_by_id(&self, from: &Rec, id: u64) -> Result<Arc<SurfaceDef>, ParseError> {
         self.cached(&self.surfaces, from, id, |inst| self.read_surface(inst))
     }
 
@@ -950,12 +950,12 @@ impl<'e, 'a> Resolver<'e, 'a> {
         self.point(&v, 1)
     }
 
-    fn edge(&self, from: &Rec, id: u64) -> Result<Rc<Edge>, ParseError> {
+    fn edge(&self, from: &Rec, id: u64) -> Result<Arc<Edge>, ParseError> {
         if let Some(e) = self.edges.borrow().get(&id) {
             return Ok(e.clone());
         }
         let e = self.expect_type(from, id, &["EDGE_CURVE"], 3)?;
-        let edge = Rc::new(Edge {
+        let edge = Arc::new(Edge {
             id,
             start: self.vertex(&e, 1)?,
             end: self.vertex(&e, 2)?,

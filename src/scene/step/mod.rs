@@ -22,10 +22,11 @@ pub mod style;
 pub mod topology;
 pub mod units;
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::Path;
 
 use glam::{DAffine3, DVec3};
+use rayon::prelude::*;
 
 use self::entities::Resolver;
 use self::style::Colour;
@@ -254,20 +255,45 @@ pub fn read_step_str(path: &Path, src: &str) -> Result<StepModel, ParseError> {
     } else {
         1.0
     };
-    // Faces converted once, placed per occurrence.
-    let mut converted: HashMap<u64, Option<Surface>> = HashMap::new();
-    let mut palette: Vec<Colour> = Vec::new();
-    let mut groups: BTreeMap<(usize, usize), Vec<Surface>> = BTreeMap::new();
-    for (k, occ) in occurrences.iter().enumerate() {
+    // Faces resolved once, in file order (the resolver's caches are not shared), then
+    // converted on every core (each face on its own), then placed per occurrence.
+    let mut placed: Vec<Vec<(u64, Option<Colour>)>> = Vec::with_capacity(occurrences.len());
+    let mut resolved: Vec<(u64, entities::Face)> = Vec::new();
+    let mut seen: HashSet<u64> = HashSet::new();
+    for occ in &occurrences {
         let mut faces = Vec::new();
         for &item in &occ.items {
             item_faces(&res, item, &colours, None, &mut faces, 0)?;
         }
-        for (fid, colour) in faces {
-            if let std::collections::hash_map::Entry::Vacant(slot) = converted.entry(fid) {
-                slot.insert(convert_one(&res, fid, size, &mut report, &mut unsupported)?);
+        for &(fid, _) in &faces {
+            if seen.insert(fid)
+                && let Some(face) = resolve_face(&res, fid, &mut report, &mut unsupported)?
+            {
+                resolved.push((fid, face));
             }
-            let Some(surface) = &converted[&fid] else {
+        }
+        placed.push(faces);
+    }
+    let outcomes: Vec<(u64, Result<topology::FaceOutcome, String>)> = resolved
+        .par_iter()
+        .map(|(fid, face)| (*fid, topology::convert_face(face, size)))
+        .collect();
+    let mut converted: HashMap<u64, Surface> = HashMap::new();
+    for (fid, outcome) in outcomes {
+        match outcome {
+            Ok(out) => {
+                report.projected_edges += out.projected_edges;
+                report.max_projection_error = report.max_projection_error.max(out.projection_error);
+                converted.insert(fid, out.surface);
+            }
+            Err(why) => report.failed_faces.push((fid, why)),
+        }
+    }
+    let mut palette: Vec<Colour> = Vec::new();
+    let mut groups: BTreeMap<(usize, usize), Vec<Surface>> = BTreeMap::new();
+    for (k, (occ, faces)) in occurrences.iter().zip(placed).enumerate() {
+        for (fid, colour) in faces {
+            let Some(surface) = converted.get(&fid) else {
                 continue;
             };
             let material = match colour {
@@ -284,7 +310,7 @@ pub fn read_step_str(path: &Path, src: &str) -> Result<StepModel, ParseError> {
             groups.entry((k, material)).or_default().push(s);
         }
     }
-    report.faces = converted.values().filter(|s| s.is_some()).count();
+    report.faces = converted.len();
     report.failed_faces.sort_by_key(|(id, _)| *id);
     report.max_projection_error *= report.units.length.factor;
     report.unsupported = unsupported;
@@ -325,42 +351,30 @@ pub fn read_step_str(path: &Path, src: &str) -> Result<StepModel, ParseError> {
     })
 }
 
-/// Converts face `fid`; a face that is valid STEP but cannot be converted is recorded
-/// in the report and gives `None`, a malformed one is an error.
-fn convert_one(
+/// The entities of face `fid`; a face that is valid STEP but uses what the reader does not
+/// convert is recorded in the report and gives `None`, a malformed one is an error.
+fn resolve_face(
     res: &Resolver,
     fid: u64,
-    size: f64,
     report: &mut Report,
     unsupported: &mut BTreeMap<String, usize>,
-) -> Result<Option<Surface>, ParseError> {
+) -> Result<Option<entities::Face>, ParseError> {
     let Some(inst) = res.ex.get(fid) else {
         return Ok(None);
     };
     res.take_unsupported();
-    let face = match res.face(inst) {
-        Ok(f) => f,
+    match res.face(inst) {
+        Ok(f) => Ok(Some(f)),
         Err(e) => match res.take_unsupported() {
             Some(kind) => {
                 *unsupported.entry(kind.clone()).or_default() += 1;
                 report
                     .failed_faces
                     .push((fid, format!("uses {kind}, which is not supported")));
-                return Ok(None);
+                Ok(None)
             }
-            None => return Err(e),
+            None => Err(e),
         },
-    };
-    match topology::convert_face(&face, size) {
-        Ok(out) => {
-            report.projected_edges += out.projected_edges;
-            report.max_projection_error = report.max_projection_error.max(out.projection_error);
-            Ok(Some(out.surface))
-        }
-        Err(why) => {
-            report.failed_faces.push((fid, why));
-            Ok(None)
-        }
     }
 }
 

@@ -234,6 +234,39 @@ impl Domain<'_> {
 
     /// The pcurve `pc` over `[ta, tb]`, exact, if it agrees with the 3D curve there (its
     /// parameter the 3D curve's, as ISO 10303-42 intends for surface curves).
+    /// An edge on a plane, exactly: the plane's parameters are affine in space, so the
+    /// edge's homogeneous control points map to parameter-plane control points with their
+    /// weights. A curve lying in the plane has every control point in it (its basis
+    /// functions are independent), so a point off the plane means the edge is not on it.
+    fn planar_piece(&self, c: &Curve, ta: f64, tb: f64) -> Option<TrimSegment> {
+        let SurfaceDef::Plane(frame) = self.def else {
+            return None;
+        };
+        let (curve, _) = curve_to_nurbs(c, [ta, tb]).ok()?;
+        let tol = self.scale * PCURVE_TOLERANCE;
+        let mut points = Vec::with_capacity(curve.points.len());
+        for p in &curve.points {
+            if p.w.is_nan() || p.w <= 0.0 {
+                return None;
+            }
+            let l = frame.local(p.truncate() / p.w);
+            if l.z.abs() > tol {
+                return None;
+            }
+            points.push(DVec3::new(l.x * p.w, l.y * p.w, p.w));
+        }
+        let (d0, d1) = crate::geom::nurbs::knots::domain(curve.degree, &curve.knots);
+        Some(TrimSegment {
+            t0: ta.max(d0),
+            t1: tb.min(d1),
+            curve: ParamCurve {
+                degree: curve.degree,
+                knots: curve.knots,
+                points,
+            },
+        })
+    }
+
     fn pcurve_piece(&self, pc: &PCurve, c3: &Curve, ta: f64, tb: f64) -> Option<TrimSegment> {
         let tol = self.scale * PCURVE_TOLERANCE;
         let agrees = [ta, 0.5 * (ta + tb), tb].iter().all(|&t| {
@@ -345,6 +378,11 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
                             list.push(seg);
                         }
                     }
+                }
+                if list.is_empty()
+                    && let Some(seg) = dom.planar_piece(c3, ta, tb)
+                {
+                    list.push(seg);
                 }
                 if list.is_empty() {
                     let (points, err) = dom
