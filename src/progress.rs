@@ -20,6 +20,39 @@ pub const LARGE_INPUT_BYTES: u64 = 4 << 20;
 /// nothing.
 const SPINNER_TICK: Duration = Duration::from_millis(120);
 
+/// [`Batched`] passes counts on in steps of at least this many.
+const BATCH: u64 = 256;
+
+/// Advances a bar in steps of at least [`BATCH`], for loops whose items take well under a
+/// microsecond. One [`ProgressBar::inc`] costs about 77 ns even on a hidden bar (it reads
+/// the clock to rate-limit drawing; indicatif 0.18.6, 10^7 calls, release build, this
+/// machine), which is about 2% of a 64,000-patch BVH build (0.30–0.43 s) when paid once
+/// per patch and once per leaf. What is left is added when it is dropped.
+pub struct Batched<'a> {
+    bar: &'a ProgressBar,
+    pending: u64,
+}
+
+impl<'a> Batched<'a> {
+    pub fn new(bar: &'a ProgressBar) -> Self {
+        Batched { bar, pending: 0 }
+    }
+
+    pub fn add(&mut self, n: u64) {
+        self.pending += n;
+        if self.pending >= BATCH {
+            self.bar.inc(self.pending);
+            self.pending = 0;
+        }
+    }
+}
+
+impl Drop for Batched<'_> {
+    fn drop(&mut self) {
+        self.bar.inc(self.pending);
+    }
+}
+
 /// Whether progress is drawn: not with `--quiet`, not when stderr is not a terminal.
 fn shown(quiet: bool) -> bool {
     use std::io::IsTerminal;
@@ -80,6 +113,21 @@ pub fn while_reading<T>(quiet: bool, path: &Path, read: impl FnOnce() -> T) -> T
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn batched_counts_reach_the_bar_in_steps_and_all_on_drop() {
+        let bar = ProgressBar::hidden();
+        let mut batched = Batched::new(&bar);
+        for _ in 0..BATCH - 1 {
+            batched.add(1);
+        }
+        assert_eq!(bar.position(), 0);
+        batched.add(3);
+        assert_eq!(bar.position(), BATCH + 2);
+        batched.add(5);
+        drop(batched);
+        assert_eq!(bar.position(), BATCH + 7);
+    }
 
     #[test]
     fn quiet_or_no_terminal_hides_every_kind() {

@@ -137,30 +137,46 @@ fn merge_refuses_pieces_of_other_renders_gaps_and_overlaps() {
     assert!(!o.status.success());
 }
 
+/// Every subcommand of the clap model, nested ones too, as (its parents' names, its name).
+fn subcommands(cmd: &clap::Command, parents: &[String], out: &mut Vec<(Vec<String>, String)>) {
+    for s in cmd.get_subcommands() {
+        out.push((parents.to_vec(), s.get_name().to_string()));
+        let mut path = parents.to_vec();
+        path.push(s.get_name().to_string());
+        subcommands(s, &path, out);
+    }
+}
+
 #[test]
 fn completions_for_bash_and_zsh_name_every_subcommand() {
     use clap::CommandFactory;
-    let cmd = patchtrace::cli::Cli::command();
-    let names: Vec<String> = cmd
-        .get_subcommands()
-        .map(|s| s.get_name().to_string())
-        .collect();
-    assert!(names.len() >= 12 && names.iter().any(|n| n == "merge"));
+    let mut all = Vec::new();
+    subcommands(&patchtrace::cli::Cli::command(), &[], &mut all);
+    assert!(all.iter().filter(|(p, _)| p.is_empty()).count() >= 12);
+    assert!(all.iter().any(|(p, n)| p == &["bench"] && n == "stability"));
     for shell in ["bash", "zsh", "fish", "elvish", "powershell"] {
         let o = run(&["completions", shell]);
         assert!(o.status.success(), "{shell}: {}", stderr(&o));
         let script = String::from_utf8(o.stdout).unwrap();
-        // bash dispatches on `patchtrace,NAME)`, zsh lists `'NAME:description'`.
-        let pattern = |name: &str| match shell {
-            "bash" => Some(format!("patchtrace,{name})")),
+        // bash dispatches on `PARENT,NAME)` with PARENT `patchtrace__subcmd__bench` for
+        // `bench`'s subcommands; zsh lists `'NAME:description'` under its parent.
+        let pattern = |parents: &[String], name: &str| match shell {
+            "bash" => Some(format!(
+                "patchtrace{},{name})",
+                parents
+                    .iter()
+                    .map(|p| format!("__subcmd__{p}"))
+                    .collect::<String>()
+            )),
             "zsh" => Some(format!("'{name}:")),
             _ => None,
         };
-        for name in &names {
-            if let Some(p) = pattern(name) {
+        for (parents, name) in &all {
+            if let Some(p) = pattern(parents, name) {
                 assert!(
                     script.contains(&p),
-                    "{shell} completion does not name `{name}`"
+                    "{shell} completion does not name `{}`",
+                    [parents.join(" "), name.clone()].join(" ")
                 );
             }
         }
@@ -300,4 +316,48 @@ fn gltf_is_framed_y_up_by_default_and_up_is_refused_for_scenes() {
     );
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("bare geometry"), "{}", stderr(&o));
+}
+
+/// `up: Y` on an object turns a y-up model to stand in the z-up scene: y → z, z → -y. The
+/// teapot's box after loading is checked against the control points of `teapot.bpt` read
+/// here and turned by hand.
+#[test]
+fn an_up_y_object_stands_its_y_axis_along_z() {
+    let text = std::fs::read_to_string(testdata("teapot.bpt")).unwrap();
+    let mut tokens = text.split_whitespace().map(|t| t.parse::<f64>().unwrap());
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for _ in 0..tokens.next().unwrap() as usize {
+        let (du, dv) = (tokens.next().unwrap(), tokens.next().unwrap());
+        for _ in 0..((du + 1.0) * (dv + 1.0)) as usize {
+            for k in 0..3 {
+                let c = tokens.next().unwrap();
+                (lo[k], hi[k]) = (lo[k].min(c), hi[k].max(c));
+            }
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("up.ron");
+    let src = std::fs::read_to_string(testdata("teapot.ron")).unwrap();
+    std::fs::write(
+        &scene,
+        src.replace(
+            "geometry: File(\"teapot.bpt\"),",
+            &format!("geometry: File({:?}), up: Y,", testdata("teapot.bpt")),
+        ),
+    )
+    .unwrap();
+    let loaded = patchtrace::scene::load_scene(&scene).unwrap();
+    let b = loaded.objects[0].bounds();
+    let want_min = [lo[0], -hi[2], lo[1]];
+    let want_max = [hi[0], -lo[2], hi[1]];
+    for k in 0..3 {
+        assert!(
+            (b.min[k] - want_min[k]).abs() < 1e-12 && (b.max[k] - want_max[k]).abs() < 1e-12,
+            "axis {k}: {} {} against {} {}",
+            b.min[k],
+            b.max[k],
+            want_min[k],
+            want_max[k]
+        );
+    }
 }

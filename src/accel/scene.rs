@@ -26,7 +26,7 @@ use crate::kernel::triangle::{
     self, PACK_WIDTH, PackShear, RayShear, TriangleHit, TrianglePack, intersect_pack,
 };
 use crate::kernel::{KernelStats, PatchHit};
-use crate::progress::ProgressBar;
+use crate::progress::{Batched, ProgressBar};
 use crate::scene::{Geometry, Scene};
 
 /// Which intersection path answers queries.
@@ -324,12 +324,13 @@ impl SceneGeometry {
         let instances = place(placed, &prototypes, patches.originals.len());
         let primitives = patches.originals.len() + triangles.corners.len() + instances.len();
         progress.set_length(2 * primitives as u64);
+        let mut bounded = Batched::new(progress);
         let boxes: Vec<Aabb> = patches
             .originals
             .iter()
             .zip(&patches.trims)
             .map(|(p, trim)| {
-                progress.inc(1);
+                bounded.add(1);
                 surviving_box(p, trim.as_deref()).to_f32_outward()
             })
             .chain(
@@ -340,7 +341,8 @@ impl SceneGeometry {
             )
             .chain(instances.iter().map(|i| i.bounds))
             .collect();
-        progress.inc((triangles.corners.len() + instances.len()) as u64);
+        bounded.add((triangles.corners.len() + instances.len()) as u64);
+        drop(bounded);
         let bvh = Bvh::build_packed_with(&boxes, patches.originals.len(), progress);
         let accel = Accel::bvh(bvh, patches.originals.len(), &triangles);
         Self::with_accel(patches, triangles, accel, instances, prototypes)

@@ -9,7 +9,7 @@ use glam::DVec3;
 use super::{Bvh, MAX_DEPTH, MAX_LEAF_PRIMS, Node};
 use crate::geom::Aabb;
 use crate::kernel::triangle::PACK_WIDTH;
-use crate::progress::ProgressBar;
+use crate::progress::{Batched, ProgressBar};
 
 /// Centroid bins per axis. Wald 2007 §3.1 finds 16–32 bins within a few percent of the full
 /// sweep SAH; the upper end costs little for patch counts.
@@ -45,7 +45,7 @@ pub(super) fn area(b: &Aabb) -> f64 {
 }
 
 /// The tree over `boxes`; primitives from `first_packed` on are priced in packs (see
-/// [`PACK_COST`]). `progress` advances by each leaf's primitives as the leaf is made, so it
+/// [`PACK_COST`]). `progress` advances by the leaves' primitives as they are made, so it
 /// reaches `boxes.len()` when the tree is done.
 pub(super) fn build(boxes: &[Aabb], first_packed: usize, progress: &ProgressBar) -> Bvh {
     let n = boxes.len();
@@ -60,7 +60,7 @@ pub(super) fn build(boxes: &[Aabb], first_packed: usize, progress: &ProgressBar)
         prims: (0..n as u32).collect(),
         first_packed: first_packed.min(n) as u32,
         nodes: Vec::with_capacity((2 * n).saturating_sub(1)),
-        progress,
+        progress: Batched::new(progress),
     };
     if n > 0 {
         builder.nodes.push(Node {
@@ -80,7 +80,7 @@ struct Builder<'a> {
     /// Primitives with this index or above are tested in packs.
     first_packed: u32,
     nodes: Vec<Node>,
-    progress: &'a ProgressBar,
+    progress: Batched<'a>,
 }
 
 #[derive(Clone, Copy)]
@@ -126,7 +126,7 @@ impl Builder<'_> {
                 first: start as u32,
                 count: count as u32,
             };
-            self.progress.inc(count as u64);
+            self.progress.add(count as u64);
             return;
         };
         let mid = match split {
