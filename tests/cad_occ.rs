@@ -149,3 +149,10 @@ fn occ_step_part_hits_every_face_kind_passes_its_holes_and_faces_outward() {
 fn occ_iges_faces_part_hits_every_face_kind_and_passes_its_holes() {
     check("occ/bracket_occ_faces.igs", false);
 }
+
+#[test]
+fn occ_iges_brep_part_hits_every_face_kind_and_passes_its_holes() {
+    // A 186 solid whose cylinders and dome (192, 196) carry parameter-space curves in
+    // degrees, OpenCASCADE's convention.
+    check("occ/bracket_occ_brep.igs", false);
+}

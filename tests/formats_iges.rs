@@ -1014,23 +1014,24 @@ fn hyperbolic_conic_arc_in_general_position() {
 fn manifold_solid_b_rep_faces_with_edge_lists_and_loops() {
     let n = net();
     let (c, r) = (DVec3::new(0.0, 0.0, 5.0), 1.5);
-    // 0: 128; 1–3: 110 model-space curves (unused: parameter curves are given);
-    // 4–6: 110 parameter curves, the third written backwards; 7: 504; 8: 508 (the third
-    // edge OF 0); 9: 510 on the 128; 10: 116; 11: 196; 12: 510 on the sphere, no loops;
-    // 13: 514; 14: 186 (colour 3, translated by 15: 124).
+    // 0: 128; 1–3: 110 model-space curves (unused: parameter curves are given), the
+    // third written backwards; 4–6: 110 parameter curves along the loop; 7: 504; 8: 508
+    // (the third edge OF 0: its model-space curve runs against the loop); 9: 510 on the
+    // 128; 10: 116; 11: 196; 12: 510 on the sphere, no loops; 13: 514; 14: 186 (colour 3,
+    // translated by 15: 124).
     let uv = [(0.1, 0.1), (0.9, 0.1), (0.9, 0.9)];
     let model = |(u, v): (f64, f64)| net_point(&n, u, v);
     let mut ents = vec![ent(128, &b128(&n, [0.0, 1.0, 0.0, 1.0]))];
     for k in 0..3 {
-        let (a, b) = (model(uv[k]), model(uv[(k + 1) % 3]));
+        let (a, b) = if k == 2 {
+            (model(uv[0]), model(uv[2]))
+        } else {
+            (model(uv[k]), model(uv[k + 1]))
+        };
         ents.push(ent(110, &[a.x, a.y, a.z, b.x, b.y, b.z]));
     }
     for k in 0..3 {
-        let (a, b) = if k == 2 {
-            (uv[0], uv[2])
-        } else {
-            (uv[k], uv[k + 1])
-        };
+        let (a, b) = (uv[k], uv[(k + 1) % 3]);
         ents.push(ent(110, &[a.0, a.1, 0.0, b.0, b.1, 0.0]));
     }
     let mut edges = vec![3.0];

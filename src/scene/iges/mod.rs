@@ -37,6 +37,11 @@ use crate::scene::model::Surface;
 pub struct Model {
     pub entries: Vec<DirEntry>,
     pub entities: Vec<Entity>,
+    /// The parameter-space curves on 192–196 give their angles in degrees: files written
+    /// by OpenCASCADE, whose IGES writer and reader (`IGESToBRep_TopoSurface::ParamSurface`)
+    /// scale the angles of cylinders, cones (u) and spheres (u and v) by 180/π; the 5.3
+    /// text read here gives radians.
+    pub angles_in_degrees: bool,
 }
 
 /// Nesting limit of transforms referring to transforms, against cycles.
@@ -290,7 +295,18 @@ pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
         }
         entities.push(entities::read(&p)?);
     }
-    let model = Model { entries, entities };
+    // Global parameters 3, 5 and 6 name the sending product, system and preprocessor.
+    let angles_in_degrees = [3, 5, 6].iter().any(|&i| {
+        text(i).is_some_and(|t| {
+            let t = t.to_ascii_lowercase();
+            t.contains("open cascade") || t.contains("opencascade")
+        })
+    });
+    let model = Model {
+        entries,
+        entities,
+        angles_in_degrees,
+    };
     // Some writers leave the surface under a 144 marked independent; it is drawn through
     // the 144 only (drawn again, its untrimmed whole would cover the trims). Members of
     // subfigure definitions are drawn through their instances only.

@@ -29,8 +29,12 @@ const PROJECTED_PER_SEGMENT: usize = 24;
 struct Edge {
     model: usize,
     parameter: Vec<usize>,
-    /// Runs against the boundary's direction (141 SENSE 2).
+    /// The model-space curve runs against the boundary's direction (141 SENSE 2, 508
+    /// OF 0).
     reversed: bool,
+    /// So do the parameter-space curves: in a 141 they follow their model-space curve; in
+    /// a 508 they already follow the loop (as OpenCASCADE writes and reads them).
+    parameter_reversed: bool,
 }
 
 /// A closed boundary of a surface, from a 142 or a 141.
@@ -54,6 +58,7 @@ pub fn untrimmed(model: &Model, pointer: usize, report: &mut Report) -> Result<S
                 model: *boundary,
                 parameter: Vec::new(),
                 reversed: false,
+                parameter_reversed: false,
             };
             let loops = vec![Boundary {
                 hole: false,
@@ -152,6 +157,7 @@ pub fn face(model: &Model, pointer: usize, report: &mut Report) -> Result<Surfac
                 model: curve,
                 parameter: e.parameter.clone(),
                 reversed: e.reversed,
+                parameter_reversed: false,
             });
         }
         boundaries.push(Boundary {
@@ -187,6 +193,7 @@ fn curve_on_surface(model: &Model, pointer: usize, hole: bool) -> Result<Boundar
                 .into_iter()
                 .collect(),
             reversed: false,
+            parameter_reversed: false,
         }],
     })
 }
@@ -210,6 +217,7 @@ fn boundary_entity(model: &Model, pointer: usize, hole: bool) -> Result<Boundary
                 model: c.model,
                 parameter: c.parameter.clone(),
                 reversed: c.reversed,
+                parameter_reversed: c.reversed,
             })
             .collect(),
     })
@@ -312,7 +320,7 @@ fn parameter_segments(
     }
     let mut out = Vec::new();
     for &pc in &e.parameter {
-        for p in oriented(curves::pieces(model, pc)?, e.reversed) {
+        for p in oriented(curves::pieces(model, pc)?, e.parameter_reversed) {
             out.push(TrimSegment {
                 t0: p.t0,
                 t1: p.t1,
@@ -329,7 +337,7 @@ fn parameter_segments(
             });
         }
     }
-    if e.reversed {
+    if e.parameter_reversed {
         out.reverse();
     }
     Ok(Some(out))
@@ -384,6 +392,19 @@ fn analytic_with_loops(
     let plane = matches!(placed.shape, Elementary::Plane);
     let frame = placed_frame(placed);
     let angular = placed.angular();
+    // Parameter-space angles in degrees (OpenCASCADE's convention, see `Model`) become
+    // radians: a scale of the homogeneous points, exact.
+    let degree = std::f64::consts::PI / 180.0;
+    let units = if model.angles_in_degrees {
+        if matches!(placed.shape, Elementary::Torus { .. }) {
+            return Err("a torus written by OpenCASCADE (parameters in degrees, u and v exchanged) is not read yet".into());
+        }
+        // The sphere's latitude too, though it is not periodic.
+        let sphere = matches!(placed.shape, Elementary::Sphere { .. });
+        [angular[0], angular[1] || sphere].map(|a| (if a { degree } else { 1.0 }, 0.0))
+    } else {
+        [(1.0, 0.0), (1.0, 0.0)]
+    };
     let mut trims = Vec::new();
     for l in loops {
         let mut segments = Vec::new();
@@ -391,7 +412,7 @@ fn analytic_with_loops(
             // Form 0 has no parameterisation the writer and this reader share: its
             // parameter-space curves are the last resort.
             let prefer_model = l.model_preferred || !placed.parameterised;
-            if let Some(s) = parameter_segments(model, prefer_model, e, [(1.0, 0.0), (1.0, 0.0)])? {
+            if let Some(s) = parameter_segments(model, prefer_model, e, units)? {
                 segments.extend(s);
                 continue;
             }
