@@ -156,3 +156,23 @@ fn occ_iges_brep_part_hits_every_face_kind_and_passes_its_holes() {
     // degrees, OpenCASCADE's convention.
     check("occ/bracket_occ_brep.igs", false);
 }
+
+/// Found by the mutation run (`benches/mutation_run.rs`): OpenCASCADE's two-solid file with
+/// one part's shape representation deleted made the assembly walk look up a product that
+/// had none, and panic. That part now places nothing; the other part's 3 faces still load.
+#[test]
+fn a_part_without_its_shape_representation_places_nothing() {
+    let text = std::fs::read_to_string(testdata("occ/torus_cone_occ.step")).unwrap();
+    let cut: Vec<&str> = text
+        .lines()
+        .filter(|l| !l.starts_with("#36 = ADVANCED_BREP_SHAPE_REPRESENTATION"))
+        .collect();
+    assert_eq!(cut.len() + 1, text.lines().count(), "the line to delete");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("cut.step");
+    std::fs::write(&path, cut.join("\n")).unwrap();
+    let o = common::run(&["info", path.to_str().unwrap()]);
+    let (out, err) = (common::stdout(&o), common::stderr(&o));
+    assert!(o.status.success(), "{err}");
+    assert!(out.contains("faces: 3 converted, 0 failed"), "{out}");
+}

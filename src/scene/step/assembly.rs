@@ -213,11 +213,15 @@ pub fn occurrences(
                 format!("the assembly flattens into more than {MAX_OCCURRENCES} occurrences"),
             ));
         }
-        for &rep in &members[&p] {
-            let (items, context) = &reps[&rep];
+        // A link may name a product with no shape (a mutated or partial file): it then
+        // places nothing.
+        for rep in members.get(&p).into_iter().flatten() {
+            let Some((items, context)) = reps.get(rep) else {
+                continue;
+            };
             if !items.is_empty() {
                 out.push(Occurrence {
-                    representation: rep,
+                    representation: *rep,
                     items: items.clone(),
                     transform: t,
                     context: *context,
