@@ -11,14 +11,11 @@ use common::{run, stderr, stdout, trace_hits};
 use glam::DVec3;
 use step_support::{FILLET, HOLE, PLATE, bracket};
 
-struct Hit {
-    point: DVec3,
-}
-
-fn trace(scene: &std::path::Path, rays: &[(DVec3, DVec3)]) -> Vec<Option<Hit>> {
+/// The hit point of each ray, `None` for a miss.
+fn trace(scene: &std::path::Path, rays: &[(DVec3, DVec3)]) -> Vec<Option<DVec3>> {
     trace_hits(scene, rays)
         .into_iter()
-        .map(|h| h.map(|(point, _)| Hit { point }))
+        .map(|h| h.map(|(point, _)| point))
         .collect()
 }
 
@@ -115,9 +112,9 @@ fn rays_at_the_middle_of_every_face_hit_that_face() {
         let hit = hit.as_ref().unwrap_or_else(|| panic!("{name}: missed"));
         // f32 rendering precision of a part 4 across: a few ulps of 4.
         assert!(
-            hit.point.distance(*want) < 1e-5,
+            hit.distance(*want) < 1e-5,
             "{name}: hit {} expected {want}",
-            hit.point
+            hit
         );
     }
 }
@@ -153,7 +150,7 @@ fn rays_through_the_hole_pass_and_just_outside_it_hit_the_top() {
         assert!(
             hit.is_none(),
             "ray from {o} along {d} through the hole hit {}",
-            hit.as_ref().unwrap().point
+            hit.unwrap()
         );
     }
     // Just outside the fillet's outer circle (radius HOLE + FILLET), every 15 degrees.
@@ -166,11 +163,7 @@ fn rays_through_the_hole_pass_and_just_outside_it_hit_the_top() {
         .collect();
     for ((o, _), hit) in outside.iter().zip(trace(&part, &outside)) {
         let hit = hit.unwrap_or_else(|| panic!("ray down at {o} missed the top plane"));
-        assert!(
-            (hit.point.z - 1.0).abs() < 1e-5,
-            "at {o}: hit {}",
-            hit.point
-        );
+        assert!((hit.z - 1.0).abs() < 1e-5, "at {o}: hit {}", hit);
     }
 }
 
