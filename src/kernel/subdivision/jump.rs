@@ -317,7 +317,7 @@ pub fn plan(
         levels[d] = k - drop;
         index[d] = a >> drop;
         let (near_lo, near_hi) = window(d, near_radius);
-        holds_near &= !(borders[d][0] && near_lo < 0.0) && !(borders[d][1] && near_hi > 1.0);
+        holds_near &= !((borders[d][0] && near_lo < 0.0) || (borders[d][1] && near_hi > 1.0));
     }
     if levels[0] + levels[1] >= MIN_JUMP_LEVELS {
         JumpOutcome::Landed(Jump {
