@@ -10,33 +10,24 @@
 //!
 //! Run: `cargo bench --bench bvh_build` (or `-- COUNT` for another number of teapots).
 
+mod support;
+
 use std::path::Path;
 use std::time::Instant;
+
+use support::process_cpu_seconds;
 
 use patchtrace::accel::mapped;
 use patchtrace::accel::scene::{FromFile, SceneGeometry};
 use patchtrace::scene::generate::{TEAPOT_BPT, TeapotsSpec, teapots_scene};
 use patchtrace::scene::{LoadOptions, load_scene_keyed};
 
-/// User plus system CPU seconds of this process so far, all threads.
-fn cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
-    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
-    let fields: Vec<f64> = rest
-        .split_whitespace()
-        .skip(11)
-        .take(2)
-        .filter_map(|f| f.parse().ok())
-        .collect();
-    fields.iter().sum::<f64>() / 100.0
-}
-
 /// Runs `f`, returning its value and its (wall, CPU) seconds.
 fn timed<T>(f: impl FnOnce() -> T) -> (T, f64, f64) {
-    let (wall, cpu) = (Instant::now(), cpu_seconds());
+    let cpu = || process_cpu_seconds().unwrap_or(f64::NAN);
+    let (wall, before) = (Instant::now(), cpu());
     let v = f();
-    (v, wall.elapsed().as_secs_f64(), cpu_seconds() - cpu)
+    (v, wall.elapsed().as_secs_f64(), cpu() - before)
 }
 
 fn main() {

@@ -15,13 +15,11 @@ use patchtrace::scene::iges::{directory, read_iges, records};
 #[path = "../tests/iges_support/mod.rs"]
 mod iges_support;
 use iges_support::{Entry, fixed_format};
+#[path = "support/mod.rs"]
+mod support;
+use support::{median, thread_cpu_seconds as cpu_seconds};
 
 const RUNS: usize = 7;
-
-fn cpu_seconds() -> Option<f64> {
-    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    Some(s.split_whitespace().next()?.parse::<f64>().ok()? * 1e-9)
-}
 
 /// Parameter positions (1-based) that are directory pointers, for the entity types the
 /// hammer holds (the lists of 144 holes and 102 parts run to the end).
@@ -114,10 +112,6 @@ fn main() {
             }
             assert_eq!(r.surfaces.len(), first.surfaces.len());
         }
-        let median = |v: &mut Vec<f64>| {
-            v.sort_by(f64::total_cmp);
-            v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-        };
         println!(
             "iges_read: {:.2} MB, {} trimmed surfaces, {} patches: median {:.3} s wall, {:.3} s CPU (min {:.3} s wall), {RUNS} runs",
             text.len() as f64 / 1e6,
@@ -130,8 +124,8 @@ fn main() {
                     patchtrace::scene::SurfaceGeometry::Bezier(_) => 1,
                 })
                 .sum::<usize>(),
-            median(&mut wall.clone()),
-            median(&mut cpu),
+            median(wall.clone()),
+            median(cpu),
             wall.iter().copied().fold(f64::INFINITY, f64::min),
         );
     }

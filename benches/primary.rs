@@ -17,16 +17,12 @@ use patchtrace::render::camera::CameraRays;
 use patchtrace::scene::{Geometry, Object, Scene, Surface, bpt::read_bpt, load_scene};
 use patchtrace::tessellate::{TessellationMode, tessellate_scene};
 
+#[path = "support/mod.rs"]
+mod support;
+use support::{median, thread_cpu_seconds as cpu_seconds};
+
 const RUNS: usize = 5;
 const SIZE: u32 = 512;
-
-/// Seconds this thread has run on a CPU (Linux `/proc/thread-self/schedstat`, first field in
-/// ns), or `None` elsewhere. On a shared machine wall time counts the waits for a core too;
-/// "per core" throughput divides by this instead.
-fn cpu_seconds() -> Option<f64> {
-    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    Some(s.split_whitespace().next()?.parse::<f64>().ok()? * 1e-9)
-}
 
 /// Median wall seconds and median on-CPU seconds (wall where unavailable) to trace `rays`
 /// through `geometry`, and the number of hits.
@@ -47,10 +43,6 @@ fn time(geometry: &SceneGeometry, rays: &[Ray]) -> (f64, f64, usize) {
             cpu.push(cpu_seconds().zip(cpu_start).map_or(elapsed, |(b, a)| b - a));
         }
     }
-    let median = |mut v: Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
-    };
     (median(wall), median(cpu), hits)
 }
 

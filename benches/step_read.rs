@@ -10,29 +10,16 @@
 
 #[path = "../tests/step_support/mod.rs"]
 mod step_support;
+#[path = "support/mod.rs"]
+mod support;
 
 use std::time::Instant;
 
 use patchtrace::scene::step::{read_step, records};
+use support::{median, process_cpu_seconds as cpu_seconds};
 
 const RUNS: usize = 5;
 const TARGET_BYTES: usize = 5_000_000;
-
-/// Seconds all threads of this process have run on a CPU (user + system, Linux
-/// `/proc/self/stat`, in clock ticks of 1/100 s): faces convert on every core.
-fn cpu_seconds() -> Option<f64> {
-    let s = std::fs::read_to_string("/proc/self/stat").ok()?;
-    // Fields after the command name, which is in parentheses and may hold spaces.
-    let rest = &s[s.rfind(')')? + 2..];
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
-    Some(ticks / 100.0)
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
 
 fn main() {
     let one = step_support::bracket(1).len();

@@ -250,6 +250,30 @@ fn an_instance_of_an_unknown_or_later_object_is_refused_with_its_place() {
     );
 }
 
+/// The shared geometry of an instance is prepared in `f32` before its transform, so its
+/// own coordinates must fit `f32` even where the placed instance does (issue 21's range
+/// check, applied to shared geometry).
+#[test]
+fn an_instance_whose_shared_geometry_overflows_f32_is_refused_though_placed_in_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("huge.ron");
+    let patch =
+        "Bezier(degree: (1, 1), points: [(0, 0, 0), (1e39, 0, 0), (0, 1e39, 0), (1e39, 1e39, 0)])";
+    std::fs::write(
+        &path,
+        format!("Scene(camera: (eye: (0.5, 0.5, 3), look_at: (0.5, 0.5, 0), up: (0, 1, 0), fov_y: 45, width: 8, height: 8),\n objects: [\n  (name: \"big\", geometry: Surfaces([{patch}]), transform: [Scale(1e-39)]),\n  (geometry: Instance(of: \"big\"), transform: [Scale(1e-39), Translate(2, 0, 0)]),\n ])\n"),
+    )
+    .unwrap();
+    // The placed boxes are about 1 across: only the shared geometry is out of range.
+    let o = common::run(&["info", path.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", common::stderr(&o));
+    let e = common::stderr(&o);
+    assert!(
+        e.contains("\"big\"") && e.contains("before its transform") && e.contains("f32 range"),
+        "{e}"
+    );
+}
+
 #[test]
 fn mirrored_and_stretched_instances_report_the_copies_hits_and_normals() {
     let dir = tempfile::tempdir().unwrap();

@@ -6,6 +6,7 @@ use super::error::LoadError;
 use super::model::Material;
 use super::model::{Axis, Geometry, Object, Scene, Surface};
 use super::{bpt, cage, gltf_mesh, iges, mesh, obj, pbrt, ron_format, step};
+use crate::geom::bbox::DAabb;
 
 /// The kinds of input file we read, by extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -236,33 +237,12 @@ pub const MIN_OBJECT_EXTENT: f64 = 1.0 / (1u64 << 60) as f64;
 /// the error.
 pub fn check_f32_range(path: &Path, scene: &Scene) -> Result<(), LoadError> {
     for o in &scene.objects {
-        let b = o.bounds();
-        if b.is_empty() {
-            continue;
-        }
-        let extent = b.extent().max_element();
-        if extent > 0.0 && extent < MIN_OBJECT_EXTENT {
-            return Err(LoadError::invalid(
-                path,
-                format!(
-                    "object \"{}\" is only {extent:e} across, below the {MIN_OBJECT_EXTENT:e} that f32 shading resolves (distances would square into the subnormal range); scale the scene up",
-                    o.name
-                ),
-            ));
-        }
-        let largest = b.min.abs().max(b.max.abs()).max_element();
-        // Box arithmetic (slab tests, extents, the default camera's distance) works on
-        // differences of coordinates, so the extent must fit as well: a patch at ±3e38
-        // has finite corners but an infinite f32 width.
-        if !((largest as f32).is_finite()) || !((extent as f32).is_finite()) {
-            return Err(LoadError::invalid(
-                path,
-                format!(
-                    "object \"{}\": coordinates reach {largest:e} and the box spans {extent:e} after transforms, beyond the f32 range (±{:e}) the renderer works in; scale the scene down",
-                    o.name,
-                    f32::MAX
-                ),
-            ));
+        check_box_range(path, &o.name, "", &o.bounds())?;
+        // An instance's shared geometry is prepared in `f32` in its own coordinates, before
+        // its transform: a file at 1e39 scaled by 1e-10 is placed in range but would
+        // round to infinity there.
+        if let Geometry::Instance(i) = &o.geometry {
+            check_box_range(path, &o.name, " before its transform", &i.geometry.bounds())?;
         }
     }
     let c = &scene.camera;
@@ -273,6 +253,42 @@ pub fn check_f32_range(path: &Path, scene: &Scene) -> Result<(), LoadError> {
                 "camera: eye {} or look_at {} is beyond the f32 range (±{:e}) the renderer works in",
                 c.eye,
                 c.look_at,
+                f32::MAX
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// [`check_f32_range`] for one box of object `name`; `when` says which coordinates the box
+/// is in (empty for the placed object).
+fn check_box_range(path: &Path, name: &str, when: &str, b: &DAabb) -> Result<(), LoadError> {
+    if b.is_empty() {
+        return Ok(());
+    }
+    let extent = b.extent().max_element();
+    if extent > 0.0 && extent < MIN_OBJECT_EXTENT {
+        return Err(LoadError::invalid(
+            path,
+            format!(
+                "object \"{name}\" is only {extent:e} across{when}, below the {MIN_OBJECT_EXTENT:e} that f32 shading resolves (distances would square into the subnormal range); scale the scene up"
+            ),
+        ));
+    }
+    let largest = b.min.abs().max(b.max.abs()).max_element();
+    // Box arithmetic (slab tests, extents, the default camera's distance) works on
+    // differences of coordinates, so the extent must fit as well: a patch at ±3e38
+    // has finite corners but an infinite f32 width.
+    if !((largest as f32).is_finite()) || !((extent as f32).is_finite()) {
+        return Err(LoadError::invalid(
+            path,
+            format!(
+                "object \"{name}\": coordinates reach {largest:e} and the box spans {extent:e}{}, beyond the f32 range (±{:e}) the renderer works in; scale the scene down",
+                if when.is_empty() {
+                    " after transforms"
+                } else {
+                    when
+                },
                 f32::MAX
             ),
         ));
