@@ -18,7 +18,7 @@ use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 use serde_json::Value;
 
-use patchtrace::accel::bvh::{Bvh, GeometryHasher};
+use patchtrace::accel::bvh::{Bvh, checksum};
 use patchtrace::geom::{Aabb, Ray};
 use patchtrace::scene::LoadError;
 use patchtrace::scene::gltf_mesh::read_gltf;
@@ -394,13 +394,11 @@ fn bvh_files_survive_mutations_behind_a_valid_checksum() {
     runner()
         .run(&prop::collection::vec(byte_edit(), 1..4), |edits| {
             let mut bytes = apply_bytes(file.clone(), &edits);
-            // Re-seal the checksum (FNV-1a 64 of everything before it) so the damage
-            // reaches the header checks and the tree validation.
+            // Re-seal the checksum (of everything before it) so the damage reaches the
+            // header checks and the tree validation.
             if bytes.len() >= 8 {
                 let body = bytes.len() - 8;
-                let mut h = GeometryHasher::new();
-                h.write_bytes(&bytes[..body]);
-                let sum = h.finish().to_le_bytes();
+                let sum = checksum(&bytes[..body]).to_le_bytes();
                 bytes[body..].copy_from_slice(&sum);
             }
             match Bvh::read(&mut &bytes[..], 7) {

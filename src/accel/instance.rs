@@ -99,15 +99,6 @@ impl Placement {
         })
     }
 
-    /// Adds what places the instance to a BVH file's geometry hash.
-    pub fn hash_into(&self, h: &mut super::bvh::GeometryHasher) {
-        h.write_u64(u64::from(self.prototype));
-        h.write_u64(u64::from(self.object));
-        for x in self.to_world.to_cols_array() {
-            h.write_f64(x);
-        }
-    }
-
     /// `ray` in object space, rounded once to `f32`; `t` keeps its meaning.
     pub fn ray_to_object(&self, ray: &Ray) -> Ray {
         Ray {

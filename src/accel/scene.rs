@@ -13,10 +13,13 @@ use std::borrow::Cow;
 use std::ops::ControlFlow;
 
 use glam::{DVec3, Vec3};
+use rayon::prelude::*;
 
-use super::bvh::{Bvh, GeometryHasher};
+use super::bvh::Bvh;
 use super::grid::Grid;
 use super::instance::Placement;
+use super::mapped;
+use super::patches::{OwnedPatches, PatchStore};
 use crate::geom::trim::PatchTrim;
 use crate::geom::{Aabb, BezierPatch, DAabb, Ray};
 use crate::kernel::cached::{self, CachedConfig};
@@ -231,6 +234,15 @@ enum Accel {
 
 impl Accel {
     fn bvh(bvh: Bvh, patches: usize, triangles: &Triangles) -> Accel {
+        if triangles.corners.is_empty() {
+            // No packs: every leaf's pack range is empty.
+            let none = LeafPacks {
+                packs: Vec::new(),
+                lanes: Vec::new(),
+                start: vec![0; bvh.prim_count() + 1],
+            };
+            return Accel::Bvh(bvh, none);
+        }
         let packs = LeafPacks::new(&bvh, patches as u32, &triangles.corners);
         Accel::Bvh(bvh, packs)
     }
@@ -238,12 +250,7 @@ impl Accel {
 
 /// Prepared geometry of a scene.
 pub struct SceneGeometry {
-    prepared: Vec<PreparedPatch>,
-    originals: Vec<BezierPatch>,
-    /// (object, patch within object) per patch.
-    ids: Vec<(u32, u32)>,
-    /// Per patch, its trim where its loops cut it.
-    trims: Vec<Option<Box<PatchTrim>>>,
+    patches: PatchStore,
     triangles: Triangles,
     accel: Accel,
     /// The instances, top-level primitives after the triangles, and the geometry they
@@ -324,25 +331,28 @@ impl SceneGeometry {
         let instances = place(placed, &prototypes, patches.originals.len());
         let primitives = patches.originals.len() + triangles.corners.len() + instances.len();
         progress.set_length(2 * primitives as u64);
-        let mut bounded = Batched::new(progress);
-        let boxes: Vec<Aabb> = patches
+        // Bounding is independent per patch (a trimmed patch's box is the costly part), so
+        // it runs on every core.
+        let mut boxes: Vec<Aabb> = patches
             .originals
-            .iter()
+            .par_iter()
             .zip(&patches.trims)
-            .map(|(p, trim)| {
-                bounded.add(1);
-                surviving_box(p, trim.as_deref()).to_f32_outward()
-            })
-            .chain(
-                triangles
-                    .corners
-                    .iter()
-                    .map(|c| c.iter().copied().collect()),
+            .map_init(
+                || Batched::new(progress),
+                |bounded, (p, trim)| {
+                    bounded.add(1);
+                    surviving_box(p, trim.as_deref()).to_f32_outward()
+                },
             )
-            .chain(instances.iter().map(|i| i.bounds))
             .collect();
-        bounded.add((triangles.corners.len() + instances.len()) as u64);
-        drop(bounded);
+        boxes.extend(
+            triangles
+                .corners
+                .iter()
+                .map(|c| c.iter().copied().collect::<Aabb>()),
+        );
+        boxes.extend(instances.iter().map(|i| i.bounds));
+        progress.inc((triangles.corners.len() + instances.len()) as u64);
         let bvh = Bvh::build_packed_with(&boxes, patches.originals.len(), progress);
         let accel = Accel::bvh(bvh, patches.originals.len(), &triangles);
         Self::with_accel(patches, triangles, accel, instances, prototypes)
@@ -378,29 +388,23 @@ impl SceneGeometry {
         instances: Vec<Placement>,
         prototypes: Vec<SceneGeometry>,
     ) -> SceneGeometry {
-        let prepared = patches.originals.iter().map(PreparedPatch::new).collect();
+        let prepared = patches
+            .originals
+            .par_iter()
+            .map(PreparedPatch::new)
+            .collect();
         SceneGeometry {
-            prepared,
-            originals: patches.originals,
-            ids: patches.ids,
-            trims: patches.trims,
+            patches: PatchStore::Owned(OwnedPatches {
+                prepared,
+                originals: patches.originals,
+                ids: patches.ids,
+                trims: patches.trims,
+            }),
             triangles,
             accel,
             instances,
             prototypes,
         }
-    }
-
-    /// A hash of the geometry the BVH indexes: degrees and control points in file order,
-    /// then triangle corners, then the instances' boxes. A BVH file records it so that a
-    /// stale file is refused.
-    pub fn geometry_hash(&self) -> u64 {
-        hash_geometry(
-            &self.originals,
-            &self.triangles,
-            &self.instances,
-            &self.prototypes,
-        )
     }
 
     /// The BVH, when the geometry was prepared with one.
@@ -426,27 +430,32 @@ impl SceneGeometry {
             .iter()
             .map(|i| self.prototypes[i.prototype as usize].patch_count())
             .sum();
-        self.prepared.len() + instanced
+        self.patches.len() + instanced
     }
 
     /// The patches prepared in memory: those instances share, once.
     pub fn prepared_patch_count(&self) -> usize {
-        self.prepared.len()
+        self.patches.len()
             + self
                 .prototypes
                 .iter()
-                .map(|p| p.prepared.len())
+                .map(|p| p.patches.len())
                 .sum::<usize>()
     }
 
     /// Points whose convex hull holds the surface of the scene's own patches and
     /// triangles: control points and corners.
-    pub(super) fn hull_points(&self) -> impl Iterator<Item = DVec3> + '_ {
+    pub(super) fn hull_points(&self) -> Vec<DVec3> {
         let corners = self.triangles.corners.iter().flatten();
-        self.originals
-            .iter()
-            .flat_map(|p| p.euclidean_points())
+        (0..self.patches.len())
+            .flat_map(|i| {
+                self.patches
+                    .original(i)
+                    .euclidean_points()
+                    .collect::<Vec<_>>()
+            })
             .chain(corners.map(|c| c.as_dvec3()))
+            .collect()
     }
 
     pub fn instance_count(&self) -> usize {
@@ -564,8 +573,8 @@ impl SceneGeometry {
     ) -> Option<SceneHit> {
         let mut best: Option<(u32, subdivision::PatchHit64)> = None;
         let inv = dir.recip();
-        for (prim, patch) in self.originals.iter().enumerate() {
-            let b = self.prepared[prim].bounds();
+        for prim in 0..self.patches.len() {
+            let b = self.patches.bounds(prim);
             stats.bvh_box_tests += 1;
             let b = DAabb {
                 min: b.min.as_dvec3(),
@@ -577,7 +586,8 @@ impl SceneGeometry {
             }
             stats.kernel.patch_tests += 1;
             let trim = self.trim(prim as u32);
-            if let Some(h) = subdivision::intersect_f64(patch, origin, dir, tmin, limit, cfg, trim)
+            let patch = self.patches.original(prim);
+            if let Some(h) = subdivision::intersect_f64(&patch, origin, dir, tmin, limit, cfg, trim)
             {
                 best = Some((prim as u32, h));
             }
@@ -632,7 +642,7 @@ impl SceneGeometry {
         let kernel = &mut stats.kernel;
         // Made at the first leaf: most rays that miss never reach one.
         let mut shear = None;
-        let patches = self.prepared.len() as u32;
+        let patches = self.patches.len() as u32;
         let first_instance = patches + self.triangles.corners.len() as u32;
         let mut surface_tests = 0;
         // Instances' work, counted apart from `kernel`, which the closure holds.
@@ -696,7 +706,7 @@ impl SceneGeometry {
     ) -> (&SceneGeometry, Ray, Precision) {
         let placement = &self.instances[k as usize];
         let prototype = &self.prototypes[placement.prototype as usize];
-        let local = placement.precision_in_object(precision, prototype.prepared.len() as u32);
+        let local = placement.precision_in_object(precision, prototype.patches.len() as u32);
         (prototype, placement.ray_to_object(ray), local)
     }
 
@@ -710,7 +720,7 @@ impl SceneGeometry {
         stats: &mut QueryStats,
     ) -> bool {
         let shear = PackShear::new(&RayShear::new(ray));
-        let patches = self.prepared.len() as u32;
+        let patches = self.patches.len() as u32;
         let first_instance = patches + self.triangles.corners.len() as u32;
         let kernel = &mut stats.kernel;
         let mut nested = QueryStats::default();
@@ -756,7 +766,7 @@ impl SceneGeometry {
         let mut best = None;
         let kernel = &mut stats.kernel;
         let shear = RayShear::new(ray);
-        let patches = self.prepared.len() as u32;
+        let patches = self.patches.len() as u32;
         let g = grid.traverse(ray, |prim, tmax| {
             kernel.patch_tests += (prim >= patches) as u64;
             if prim < patches {
@@ -786,7 +796,7 @@ impl SceneGeometry {
         stats: &mut QueryStats,
     ) -> bool {
         let shear = RayShear::new(ray);
-        let patches = self.prepared.len() as u32;
+        let patches = self.patches.len() as u32;
         let kernel = &mut stats.kernel;
         let mut patch_ray = PatchRay::new(ray);
         let (hit, g) = grid.traverse_any(ray, |prim| {
@@ -816,19 +826,21 @@ impl SceneGeometry {
     ) -> Option<(f32, Candidate)> {
         let patch_hit = |h: PatchHit| (h.t, Candidate::Patch(prim, h));
         let r = Ray { tmax, ..*ray.ray };
-        let (patch, trim) = (&self.originals[prim as usize], self.trim(prim));
+        let trim = self.trim(prim);
+        // The f64 patch only for the kernels that take it: a mapped one is made on demand.
+        let patch = || self.patches.original(prim as usize);
         match precision {
             Precision::Toth(cfg) => {
                 let origin = cfg.surface_of_origin == Some(prim);
-                toth::intersect(patch, trim, &r, cfg, origin, kernel).map(patch_hit)
+                toth::intersect(&patch(), trim, &r, cfg, origin, kernel).map(patch_hit)
             }
             Precision::Cached(cfg) => {
                 let origin = cfg.toth.surface_of_origin == Some(prim);
-                cached::intersect(patch, trim, &r, cfg, origin, kernel).map(patch_hit)
+                cached::intersect(&patch(), trim, &r, cfg, origin, kernel).map(patch_hit)
             }
             Precision::F32(cfg) | Precision::F64(cfg) => {
-                let prepared = &self.prepared[prim as usize];
-                subdivision::nearest(prepared, trim, ray.kernel(cfg), tmax, cfg, kernel)
+                let prepared = self.patches.prepared(prim as usize);
+                subdivision::nearest(&prepared, trim, ray.kernel(cfg), tmax, cfg, kernel)
                     .map(|h| (h.t(), Candidate::Subdivision(prim, h)))
             }
         }
@@ -842,19 +854,20 @@ impl SceneGeometry {
         precision: &Precision,
         kernel: &mut KernelStats,
     ) -> bool {
-        let (patch, trim) = (&self.originals[prim as usize], self.trim(prim));
+        let trim = self.trim(prim);
+        let patch = || self.patches.original(prim as usize);
         match precision {
             Precision::Toth(cfg) => {
                 let origin = cfg.surface_of_origin == Some(prim);
-                toth::occluded(patch, trim, ray.ray, cfg, origin, kernel)
+                toth::occluded(&patch(), trim, ray.ray, cfg, origin, kernel)
             }
             Precision::Cached(cfg) => {
                 let origin = cfg.toth.surface_of_origin == Some(prim);
-                cached::occluded(patch, trim, ray.ray, cfg, origin, kernel)
+                cached::occluded(&patch(), trim, ray.ray, cfg, origin, kernel)
             }
             Precision::F32(cfg) | Precision::F64(cfg) => {
-                let prepared = &self.prepared[prim as usize];
-                subdivision::blocks(prepared, trim, ray.kernel(cfg), cfg, kernel)
+                let prepared = self.patches.prepared(prim as usize);
+                subdivision::blocks(&prepared, trim, ray.kernel(cfg), cfg, kernel)
             }
         }
     }
@@ -862,12 +875,12 @@ impl SceneGeometry {
     /// Patch `prim`'s trim, `None` where its loops do not cut it.
     #[inline]
     fn trim(&self, prim: u32) -> Option<&PatchTrim> {
-        self.trims[prim as usize].as_deref()
+        self.patches.trim(prim as usize)
     }
 
     fn finish_patch_hit(&self, prim: u32, t: f64, u: f64, v: f64, hit_box: Aabb) -> SceneHit {
-        let (object, patch) = self.ids[prim as usize];
-        let normal = self.originals[prim as usize].normal(u, v);
+        let (object, patch) = self.patches.id(prim as usize);
+        let normal = self.patches.original(prim as usize).normal(u, v);
         SceneHit {
             t,
             object,
@@ -878,7 +891,7 @@ impl SceneGeometry {
             hit_box,
             leave_box: subdivision::widen_by_net_rounding(
                 hit_box,
-                &self.prepared[prim as usize].bounds(),
+                &self.patches.bounds(prim as usize),
             ),
             normal,
             shading_normal: normal,
@@ -930,7 +943,7 @@ fn place(
         .filter_map(|&(object, k, to_world)| {
             let prototype = &prototypes[k as usize];
             let number = u32::try_from(first).ok();
-            first += prototype.prepared.len() as u64;
+            first += prototype.patches.len() as u64;
             Placement::new(k, object, prototype, to_world, number)
         })
         .collect()
@@ -956,8 +969,14 @@ fn collect_patches(objects: &[(u32, &Geometry)]) -> Patches {
         ids: Vec::new(),
         trims: Vec::new(),
     };
-    for &(o, geometry) in objects {
-        for (k, entry) in geometry.trimmed_patches().into_iter().enumerate() {
+    // Objects convert independently (NURBS to Bézier, trims), on every core, and are
+    // joined in order.
+    let per_object: Vec<_> = objects
+        .par_iter()
+        .map(|&(o, geometry)| (o, geometry.trimmed_patches()))
+        .collect();
+    for (o, entries) in per_object {
+        for (k, entry) in entries.into_iter().enumerate() {
             let Some((p, trim)) = entry else { continue };
             if p.has_zero_area() {
                 continue;
@@ -970,26 +989,58 @@ fn collect_patches(objects: &[(u32, &Geometry)]) -> Patches {
     out
 }
 
+/// A scene's geometry from its BVH file ([`mapped`]).
+pub enum FromFile {
+    /// The file holds the prepared patches: the geometry, mapped, and the scene's trim loop
+    /// count (the scene itself was read without its geometry).
+    Mapped(Box<SceneGeometry>, usize),
+    /// The file holds the tree only (triangles, instances, trimmed or general patches): the
+    /// geometry must be built from the scene, read with its geometry, with
+    /// [`SceneGeometry::with_tree`].
+    TreeOnly(Bvh),
+}
+
 impl SceneGeometry {
-    /// Prepares the scene with the BVH from `path`, refusing a file built for other
-    /// geometry or in another format with a message that says what to do.
-    pub fn load(
+    /// Opens the BVH file at `path` for a scene whose inputs have key `key` (its
+    /// [`SourceKey`](crate::scene::source_key::SourceKey) digest) and which has `objects`
+    /// objects, refusing a file built from other inputs, of another version, or damaged,
+    /// with a message that says what to do.
+    pub fn open(
+        path: &std::path::Path,
+        key: u64,
+        objects: usize,
+    ) -> Result<FromFile, crate::scene::LoadError> {
+        let file = mapped::open(path, key, objects)?;
+        Ok(match file.patches {
+            Some(patches) => {
+                let accel = Accel::bvh(file.bvh, patches.len(), &Triangles::default());
+                let geometry = SceneGeometry {
+                    patches: PatchStore::Mapped(patches),
+                    triangles: Triangles::default(),
+                    accel,
+                    instances: Vec::new(),
+                    prototypes: Vec::new(),
+                };
+                FromFile::Mapped(Box::new(geometry), file.trim_loops)
+            }
+            None => FromFile::TreeOnly(file.bvh),
+        })
+    }
+
+    /// Prepares `scene` with a tree from its BVH file ([`FromFile::TreeOnly`]); `path`
+    /// names the file in the error when the tree indexes a different number of primitives.
+    pub fn with_tree(
         scene: &Scene,
+        bvh: Bvh,
         path: &std::path::Path,
     ) -> Result<SceneGeometry, crate::scene::LoadError> {
-        use crate::scene::LoadError;
-        let file = std::fs::File::open(path).map_err(|e| LoadError::io(path, e))?;
-        let mut reader = std::io::BufReader::new(file);
         let split = Split::of(scene);
         let prototypes = split.prepare_prototypes();
         let patches = collect_patches(&split.own);
         let triangles = collect_triangles(&split.own);
         let instances = place(&split.instances, &prototypes, patches.originals.len());
-        let hash = hash_geometry(&patches.originals, &triangles, &instances, &prototypes);
-        let bvh =
-            Bvh::read(&mut reader, hash).map_err(|e| LoadError::invalid(path, e.to_string()))?;
         if bvh.prim_count() != patches.originals.len() + triangles.corners.len() + instances.len() {
-            return Err(LoadError::invalid(
+            return Err(crate::scene::LoadError::invalid(
                 path,
                 "the BVH indexes a different number of patches than the scene; rebuild it with `patchtrace bvh`",
             ));
@@ -1000,53 +1051,34 @@ impl SceneGeometry {
         ))
     }
 
-    /// Writes the BVH with the scene's geometry hash, atomically; refused for a grid.
-    pub fn save_bvh(&self, path: &std::path::Path) -> Result<(), crate::scene::LoadError> {
+    /// Writes the BVH file for inputs with key `key`, atomically: the tree, and the
+    /// prepared patches when the geometry is only patches the file can hold, with the
+    /// scene's `trim_loops`; whether it holds the patches. Refused for a grid.
+    pub fn save_bvh(
+        &self,
+        path: &std::path::Path,
+        key: u64,
+        trim_loops: usize,
+    ) -> Result<bool, crate::scene::LoadError> {
         let Accel::Bvh(bvh, _) = &self.accel else {
             return Err(crate::scene::LoadError::invalid(
                 path,
                 "the geometry was prepared with a grid, which has no BVH to write",
             ));
         };
-        let hash = self.geometry_hash();
-        crate::scene::write::write_atomic(path, |w| bvh.write(w, hash))
-    }
-}
-
-/// The hash a BVH file records: triangle corners, then degrees and control points in file
-/// order, then (for a scene with instances) each instance's placement and each shared
-/// geometry's own hash, so that a file built for other geometry is refused as stale.
-fn hash_geometry(
-    patches: &[BezierPatch],
-    triangles: &Triangles,
-    instances: &[Placement],
-    prototypes: &[SceneGeometry],
-) -> u64 {
-    let mut h = GeometryHasher::new();
-    h.write_u64(triangles.corners.len() as u64);
-    for c in triangles.corners.iter().flatten() {
-        for x in c.to_array() {
-            h.write_f64(x as f64);
-        }
-    }
-    h.write_u64(patches.len() as u64);
-    for p in patches {
-        h.write_u64(p.degree_u() as u64);
-        h.write_u64(p.degree_v() as u64);
-        for q in p.homogeneous_points() {
-            for c in q.to_array() {
-                h.write_f64(c);
+        let records = match &self.patches {
+            PatchStore::Owned(p)
+                if self.triangles.corners.is_empty() && self.instances.is_empty() =>
+            {
+                mapped::records(p)
             }
-        }
+            _ => None,
+        };
+        crate::scene::write::write_atomic(path, |w| {
+            mapped::write(w, bvh, key, records.as_deref(), trim_loops)
+        })?;
+        Ok(records.is_some())
     }
-    if !instances.is_empty() {
-        h.write_u64(instances.len() as u64);
-        instances.iter().for_each(|i| i.hash_into(&mut h));
-        prototypes
-            .iter()
-            .for_each(|p| h.write_u64(p.geometry_hash()));
-    }
-    h.finish()
 }
 
 /// Quarterings of a trimmed patch when bounding the part its loops keep: 4 × 4 pieces.

@@ -21,7 +21,9 @@ pub enum Command {
     Import(ImportArgs),
     /// Convert NURBS surfaces to Bézier patches exactly (knot insertion) and report counts.
     Convert(ConvertArgs),
-    /// Build the BVH of a scene and write it to a file that `render --bvh` loads.
+    /// Build the BVH of a scene and write it, with the prepared patches where the scene
+    /// has only untrimmed Bézier patches of the fast paths, to a file that `render --bvh`
+    /// maps.
     Bvh(BvhArgs),
     /// Render a scene to PNG or EXR.
     Render(RenderArgs),
@@ -337,6 +339,9 @@ pub struct KernelArgs {
     #[arg(long)]
     pub ignore_trims: bool,
     /// Load the BVH from this file (written by `patchtrace bvh`) instead of building it.
+    /// A file that holds the prepared patches is mapped and the scene's geometry files are
+    /// not parsed, only hashed; a file built from other inputs (a geometry file's bytes,
+    /// a transform, `--ignore-trims`) is refused.
     #[arg(long, value_name = "FILE")]
     pub bvh: Option<PathBuf>,
     /// Acceleration structure over the patches.

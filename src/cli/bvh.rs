@@ -1,23 +1,32 @@
-//! `patchtrace bvh SCENE -o FILE`: build and write the acceleration structure.
+//! `patchtrace bvh SCENE -o FILE`: build and write the acceleration structure, with the
+//! prepared patches where the scene's geometry allows (`render --bvh` maps them).
 
 use std::process::ExitCode;
 use std::time::Instant;
 
 use crate::cli::args::BvhArgs;
-use crate::cli::setup::{build_bvh, load};
+use crate::cli::setup::{build_bvh, load_keyed};
 
 pub fn run(args: BvhArgs) -> anyhow::Result<ExitCode> {
-    let scene = load(&args.scene, &args.mesh, args.quiet)?;
+    let (scene, source) = load_keyed(&args.scene, &args.mesh, args.quiet, false)?;
+    // What "built in" covers: collecting the patches (NURBS to Bézier, trims), their boxes,
+    // the tree and its wide form, and preparing the patches for the kernel.
     let start = Instant::now();
     let geometry = build_bvh(&scene, args.quiet);
     let build = start.elapsed().as_secs_f64();
-    geometry.save_bvh(&args.output)?;
+    let key = crate::accel::mapped::key(source, false);
+    let with_patches = geometry.save_bvh(&args.output, key, scene.trim_loop_count())?;
     eprintln!(
-        "wrote {}: {} patches, {} nodes, built in {:.3} s",
+        "wrote {}: {} patches, {} nodes, built in {:.3} s{}",
         args.output.display(),
         geometry.patch_count(),
         geometry.bvh().map_or(0, |b| b.node_count()),
-        build
+        build,
+        if with_patches {
+            ", with the prepared patches"
+        } else {
+            ", tree only (triangles, instances, trimmed or rational patches are prepared from the scene)"
+        }
     );
     Ok(ExitCode::SUCCESS)
 }

@@ -18,8 +18,8 @@ use crate::render::renderer::{RenderJob, render};
 use crate::render::sampler::SampleCount;
 use crate::render::stats::{PhaseTimes, RayReport};
 use crate::render::window::Window;
+use crate::scene::LoadError;
 use crate::scene::animation::frame_path;
-use crate::scene::{LoadError, Scene};
 
 /// How many samples a render took.
 #[derive(Serialize)]
@@ -48,42 +48,14 @@ impl SamplingReport {
     }
 }
 
-/// Per object its material and geometry fingerprint, shared geometry (instances, Dammertz
-/// §3.3) fingerprinted once and each instance by that and its transform: 10,000 instances
-/// of a teapot would otherwise format the teapot 10,000 times.
-fn geometry_fingerprints(scene: &Scene) -> Vec<(usize, u64)> {
-    use crate::scene::Geometry;
-    let mut shared: Vec<(*const Geometry, u64)> = Vec::new();
-    scene
-        .objects
-        .iter()
-        .map(|o| {
-            let f = match &o.geometry {
-                Geometry::Instance(i) => {
-                    let key = std::sync::Arc::as_ptr(&i.geometry);
-                    let g = match shared.iter().find(|(k, _)| *k == key) {
-                        Some(&(_, g)) => g,
-                        None => {
-                            let g = fingerprint(&i.geometry);
-                            shared.push((key, g));
-                            g
-                        }
-                    };
-                    fingerprint(&(g, i.transform))
-                }
-                other => fingerprint(other),
-            };
-            (o.material, f)
-        })
-        .collect()
-}
-
 /// What made the image, as pieces record it so `merge` can refuse pieces of different
 /// renders: the program version, fingerprints of the scene as loaded (after `--width` and
-/// `--height`; everything but object names, which change no pixel) and of the kernel
-/// flags, and every setting that changes pixels. `--bvh`
-/// is left out: a BVH file is the BVH the scene builds, wherever it is stored.
-fn provenance(scene: &Scene, args: &RenderArgs, samples: SampleCount, frame: u32) -> String {
+/// `--height`; everything but object names, which change no pixel: the geometry by its
+/// inputs' key, `scene::source_key`, the same whether the geometry was read or mapped from
+/// a BVH file) and of the kernel flags, and every setting that changes pixels. `--bvh` is
+/// left out: a BVH file is the BVH the scene builds, wherever it is stored.
+fn provenance(prepared: &Prepared, args: &RenderArgs, samples: SampleCount, frame: u32) -> String {
+    let scene = &prepared.scene;
     let kernel = crate::cli::args::KernelArgs {
         bvh: None,
         ..args.kernel.clone()
@@ -100,7 +72,8 @@ fn provenance(scene: &Scene, args: &RenderArgs, samples: SampleCount, frame: u32
             (scene.background, scene.ambient, scene.max_depth),
             &scene.lights,
             &scene.materials,
-            geometry_fingerprints(scene),
+            scene.objects.iter().map(|o| o.material).collect::<Vec<_>>(),
+            prepared.source_key,
         )),
         scene.camera.width,
         scene.camera.height,
@@ -226,7 +199,7 @@ fn render_frame(
         width,
         height,
         window,
-        provenance: provenance(scene, args, samples, frame),
+        provenance: provenance(prepared, args, samples, frame),
     };
     let bar = crate::progress::bar(args.quiet, "rendering");
     let start = Instant::now();

@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use anyhow::Context;
 
-use crate::accel::scene::{Precision, SceneGeometry};
+use crate::accel::scene::{FromFile, Precision, SceneGeometry};
 use crate::cli::args::{
     AccelChoice, HeuristicChoice, KernelArgs, KernelChoice, MeshArgs, PrecisionChoice,
     TerminationChoice,
@@ -16,7 +16,7 @@ use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig, Termination}
 use crate::kernel::toth::TothConfig;
 use crate::render::camera::CameraRays;
 use crate::render::plan::TrimEffect;
-use crate::scene::{Camera, Scene, load_scene_with};
+use crate::scene::{Camera, Scene, load_scene_keyed, load_scene_with};
 use crate::tessellate::{
     TessellateError, TessellationMode, TessellationReport, tessellate_scene_with,
 };
@@ -89,6 +89,8 @@ pub struct Prepared {
     pub prepare_seconds: f64,
     /// The trim loops as read, and whether `--ignore-trims` dropped them.
     pub trims: TrimEffect,
+    /// The key of the scene's inputs ([`load_scene_keyed`]): what its geometry is made from.
+    pub source_key: u64,
 }
 
 /// Reads the scene at `path` with `--subdivide`'s options, under a spinner when the file is
@@ -110,17 +112,19 @@ pub fn prepare(
         "--bvh loads a BVH file, which --accel grid does not use; drop one of the two flags"
     );
     let start = Instant::now();
-    let mut scene = load(scene_path, mesh, quiet)?;
+    if let (AccelChoice::Bvh, Some(path)) = (args.accel, &args.bvh) {
+        return prepare_from_file(scene_path, mesh, args, path, quiet);
+    }
+    let (mut scene, source_key) = load_keyed(scene_path, mesh, quiet, false)?;
     let trims = TrimEffect::of(&scene, args.ignore_trims);
     if args.ignore_trims {
         scene = scene.without_trims();
     }
     let load_seconds = start.elapsed().as_secs_f64();
     let start = Instant::now();
-    let geometry = match (args.accel, &args.bvh) {
-        (AccelChoice::Bvh, Some(path)) => SceneGeometry::load(&scene, path)?,
-        (AccelChoice::Bvh, None) => build_bvh(&scene, quiet),
-        (AccelChoice::Grid, _) => {
+    let geometry = match args.accel {
+        AccelChoice::Bvh => build_bvh(&scene, quiet),
+        AccelChoice::Grid => {
             let spinner = crate::progress::spinner(quiet, "building the grid");
             let grid = SceneGeometry::build_grid(&scene, args.grid_budget.saturating_mul(1 << 20));
             spinner.finish_and_clear();
@@ -133,6 +137,67 @@ pub fn prepare(
         load_seconds,
         prepare_seconds: start.elapsed().as_secs_f64(),
         trims,
+        source_key,
+    })
+}
+
+/// Reads the scene at `path` with `--subdivide`'s options and its inputs' key
+/// ([`load_scene_keyed`]); with `defer`, without parsing a RON scene's geometry files.
+pub fn load_keyed(
+    path: &Path,
+    mesh: &MeshArgs,
+    quiet: bool,
+    defer: bool,
+) -> Result<(Scene, u64), crate::scene::LoadError> {
+    crate::progress::while_reading(quiet, path, || {
+        load_scene_keyed(path, mesh.load_options(), defer)
+    })
+}
+
+/// [`prepare`] with `--bvh FILE`: the scene is read without its geometry files and the
+/// file's prepared patches are mapped; only a file that holds the tree alone (the scene
+/// has geometry its records cannot hold) makes the scene be read again, with its geometry.
+fn prepare_from_file(
+    scene_path: &Path,
+    mesh: &MeshArgs,
+    args: &KernelArgs,
+    bvh_path: &Path,
+    quiet: bool,
+) -> anyhow::Result<Prepared> {
+    let start = Instant::now();
+    let (scene, source) = load_keyed(scene_path, mesh, quiet, true)?;
+    let load_seconds = start.elapsed().as_secs_f64();
+    let start = Instant::now();
+    let key = crate::accel::mapped::key(source, args.ignore_trims);
+    let (scene, geometry, trims) = match SceneGeometry::open(bvh_path, key, scene.objects.len())? {
+        FromFile::Mapped(geometry, loops) => {
+            let trims = TrimEffect {
+                loops,
+                ignored: args.ignore_trims,
+            };
+            (scene, *geometry, trims)
+        }
+        FromFile::TreeOnly(bvh) => {
+            // A RON scene was read without its geometry files; bare geometry with it.
+            let mut scene = match crate::scene::load::InputKind::of(scene_path) {
+                Some(crate::scene::load::InputKind::Ron) => load(scene_path, mesh, quiet)?,
+                _ => scene,
+            };
+            let trims = TrimEffect::of(&scene, args.ignore_trims);
+            if args.ignore_trims {
+                scene = scene.without_trims();
+            }
+            let geometry = SceneGeometry::with_tree(&scene, bvh, bvh_path)?;
+            (scene, geometry, trims)
+        }
+    };
+    Ok(Prepared {
+        scene,
+        geometry,
+        load_seconds,
+        prepare_seconds: start.elapsed().as_secs_f64(),
+        trims,
+        source_key: source,
     })
 }
 

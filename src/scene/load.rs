@@ -156,6 +156,29 @@ pub fn load_scene_with(path: &Path, options: LoadOptions) -> Result<Scene, LoadE
     Ok(load_scene_noted(path, options)?.0)
 }
 
+/// [`load_scene_with`] and the scene's [`SourceKey`](super::source_key::SourceKey) digest,
+/// the key its BVH file is checked against. With `defer`, a RON scene's geometry files are
+/// hashed but not parsed, and the objects they feed get no geometry: for a caller that
+/// finds it prepared in a BVH file with this key. Bare geometry is always read (its default
+/// camera frames it) and keyed by its bytes and `options`.
+pub fn load_scene_keyed(
+    path: &Path,
+    options: LoadOptions,
+    defer: bool,
+) -> Result<(Scene, u64), LoadError> {
+    if InputKind::of(path) == Some(InputKind::Ron) && !options.subdivide {
+        let (scene, key) = ron_format::read_scene_keyed(path, defer)?;
+        check_f32_range(path, &scene)?;
+        check_trims(path, &scene)?;
+        return Ok((scene, key));
+    }
+    let mut key = super::source_key::SourceKey::new();
+    key.text("bare geometry");
+    key.number(u64::from(options.subdivide));
+    key.file(path)?;
+    Ok((load_scene_with(path, options)?, key.finish()))
+}
+
 /// [`load_scene_with`], with what the reader noted about the file beyond the scene (a
 /// STEP file's units, unsupported entities, faces left out), one line each, for `info`.
 pub fn load_scene_noted(

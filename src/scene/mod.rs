@@ -20,11 +20,14 @@ pub mod pbrt;
 pub mod rays;
 pub mod ron_format;
 pub mod ron_locate;
+pub mod source_key;
 pub mod step;
 pub mod summary;
 pub mod text;
 pub mod write;
 
 pub use error::{LoadError, ParseError};
-pub use load::{LoadOptions, load_geometry, load_scene, load_scene_with, load_subdivision};
+pub use load::{
+    LoadOptions, load_geometry, load_scene, load_scene_keyed, load_scene_with, load_subdivision,
+};
 pub use model::*;

@@ -12,6 +12,7 @@ use super::animation::{CameraKey, CameraPath};
 use super::error::{LoadError, ParseError};
 use super::model::*;
 use super::ron_locate::RonLocator;
+use super::source_key::SourceKey;
 use crate::geom::BezierPatch;
 use crate::geom::bezier::ParamRect;
 use crate::geom::nurbs::NurbsSurface;
@@ -279,9 +280,19 @@ pub fn parse_scene_file(path: &Path, src: &str) -> Result<SceneFile, ParseError>
 
 /// Reads a RON scene and everything it references.
 pub fn read_scene(path: &Path) -> Result<Scene, LoadError> {
+    Ok(read_scene_keyed(path, false)?.0)
+}
+
+/// [`read_scene`] with its [`SourceKey`](super::source_key) digest. With `defer`, geometry
+/// files are hashed but not parsed: the objects they feed get no geometry (the caller has
+/// it prepared already, in a BVH file with this key).
+pub fn read_scene_keyed(path: &Path, defer: bool) -> Result<(Scene, u64), LoadError> {
     let src = super::error::read_text(path)?;
     let file = parse_scene_file(path, &src)?;
-    build_scene(path, &RonLocator::new(path, &src), file)
+    let mut key = SourceKey::new();
+    key.text("ron scene");
+    let scene = build_scene(path, &RonLocator::new(path, &src), file, (defer, &mut key))?;
+    Ok((scene, key.finish()))
 }
 
 /// The deepest `max_depth` a scene may ask for. Each level can double the ray tree (a
@@ -291,7 +302,12 @@ pub fn read_scene(path: &Path) -> Result<Scene, LoadError> {
 /// ray's weight falls below 1/255 long before, unless every surface is a perfect mirror.
 pub const MAX_TRACE_DEPTH: u32 = 64;
 
-fn build_scene(path: &Path, at: &RonLocator, file: SceneFile) -> Result<Scene, LoadError> {
+fn build_scene(
+    path: &Path,
+    at: &RonLocator,
+    file: SceneFile,
+    (defer, key): (bool, &mut SourceKey),
+) -> Result<Scene, LoadError> {
     if let Some(d) = file.max_depth
         && !(1..=MAX_TRACE_DEPTH).contains(&d)
     {
@@ -343,6 +359,10 @@ fn build_scene(path: &Path, at: &RonLocator, file: SceneFile) -> Result<Scene, L
         })
         .collect();
     let mut objects: Vec<Object> = Vec::with_capacity(file.objects.len());
+    // Each geometry file is read once per load however many objects name it (a scene of
+    // 10,000 copies of one teapot read and parsed it 10,000 times).
+    let mut files: std::collections::HashMap<std::path::PathBuf, Geometry> =
+        std::collections::HashMap::new();
     for (index, o) in file.objects.iter().enumerate() {
         let material = match &o.material {
             Some(name) => materials.iter().position(|m| &m.name == name).ok_or_else(|| {
@@ -369,16 +389,41 @@ fn build_scene(path: &Path, at: &RonLocator, file: SceneFile) -> Result<Scene, L
                         )
                         .into());
                 };
+                key.text("instance");
+                key.text(of);
                 Geometry::Instance(Instance::new(shared.geometry.clone(), DAffine3::IDENTITY))
             }
+            GeometryDef::File(f) if defer => {
+                key.text("file");
+                key.file(&base.join(file_name(at, index, f)?))
+                    .map_err(|e| referenced(at, index, f, e))?;
+                Geometry::Surfaces(Vec::new())
+            }
             GeometryDef::File(f) => {
-                super::load::load_geometry(&base.join(file_name(at, index, f)?))
-                    .map_err(|e| referenced(at, index, f, e))?
+                let path = base.join(file_name(at, index, f)?);
+                key.text("file");
+                key.file(&path).map_err(|e| referenced(at, index, f, e))?;
+                match files.get(&path) {
+                    Some(g) => g.clone(),
+                    None => {
+                        let g = super::load::load_geometry(&path)
+                            .map_err(|e| referenced(at, index, f, e))?;
+                        files.insert(path, g.clone());
+                        g
+                    }
+                }
             }
             GeometryDef::Subdivision(inner) => match inner.as_ref() {
                 GeometryDef::File(f) => {
-                    super::load::load_subdivision(&base.join(file_name(at, index, f)?))
-                        .map_err(|e| referenced(at, index, f, e))?
+                    let path = base.join(file_name(at, index, f)?);
+                    key.text("subdivision");
+                    key.file(&path).map_err(|e| referenced(at, index, f, e))?;
+                    if defer {
+                        Geometry::Surfaces(Vec::new())
+                    } else {
+                        super::load::load_subdivision(&path)
+                            .map_err(|e| referenced(at, index, f, e))?
+                    }
                 }
                 _ => {
                     return Err(at
@@ -391,16 +436,21 @@ fn build_scene(path: &Path, at: &RonLocator, file: SceneFile) -> Result<Scene, L
                         .into());
                 }
             },
-            GeometryDef::Surfaces(defs) => Geometry::Surfaces(
-                defs.iter()
-                    .enumerate()
-                    .map(|(k, d)| {
-                        surface_from_def(d).map_err(|e| {
-                            at.at_surface(index, k, format!("object {index}, surface {k}: {e}"))
+            GeometryDef::Surfaces(defs) => {
+                // Inline surfaces are part of the scene text: their definitions are the key.
+                key.text("surfaces");
+                key.text(&format!("{defs:?}"));
+                Geometry::Surfaces(
+                    defs.iter()
+                        .enumerate()
+                        .map(|(k, d)| {
+                            surface_from_def(d).map_err(|e| {
+                                at.at_surface(index, k, format!("object {index}, surface {k}: {e}"))
+                            })
                         })
-                    })
-                    .collect::<Result<_, _>>()?,
-            ),
+                        .collect::<Result<_, _>>()?,
+                )
+            }
         };
         let stand = DAffine3::from_mat3(o.up.unwrap_or(Axis::Z).to_z_up());
         let m = o.transform.iter().fold(stand, |acc, t| t.to_affine() * acc);
@@ -415,9 +465,12 @@ fn build_scene(path: &Path, at: &RonLocator, file: SceneFile) -> Result<Scene, L
         });
         // Geometry an instance refers to is kept unplaced and shared, this object being
         // its first instance; any other is placed in world space now.
-        if referenced_names.contains(name.as_str()) && !matches!(geometry, Geometry::Instance(_)) {
+        let shared = referenced_names.contains(name.as_str());
+        if shared && !matches!(geometry, Geometry::Instance(_)) {
             geometry = Geometry::Instance(Instance::new(Arc::new(geometry), DAffine3::IDENTITY));
         }
+        key.number(u64::from(shared));
+        key.transform(&m);
         if m != DAffine3::IDENTITY {
             geometry.transform(&m);
         }

@@ -1,4 +1,6 @@
-//! The BVH file: versioned, little-endian, checksummed, and validated on load.
+//! The tree section of a BVH file: versioned, little-endian, checksummed, and validated on
+//! load. A scene's BVH file is this section followed by its prepared patches
+//! ([`crate::accel::mapped`]).
 //!
 //! Layout (all integers little-endian):
 //!
@@ -6,33 +8,38 @@
 //! |---|---|---|
 //! | 0 | 8 | [`MAGIC`] |
 //! | 8 | 4 | format version `u32` ([`FORMAT_VERSION`]) |
-//! | 12 | 8 | geometry hash `u64` ([`GeometryHasher`](super::GeometryHasher) of the scene) |
+//! | 12 | 8 | input key `u64`: what the tree was built from (`scene::source_key`) |
 //! | 20 | 8 | node count `u64` |
 //! | 28 | 8 | primitive count `u64` |
 //! | 36 | 32 × nodes | [`Node`]s: `min.xyz`, `max.xyz` as `f32` bits, `first`, `count`, each a `u32` |
 //! | … | 4 × prims | primitive indices, `u32` |
-//! | … | 8 | checksum `u64`: FNV-1a 64 of every byte before it |
+//! | … | 8 | [`checksum`] `u64` of every byte before it |
 //!
-//! Every field of a node is a 4-byte word, so nodes are written as their `bytemuck` words each
-//! converted with `to_le_bytes`: the same file on little- and big-endian hosts (a no-op on
-//! little-endian ones, a byte swap on big-endian ones).
+//! Every field of a node is a 4-byte word at a 4-byte offset, so on a little-endian host the
+//! nodes and indices are cast from the bytes (`bytemuck`, which checks size and alignment)
+//! and copied once; a big-endian host converts each word.
 
 use std::io::{self, Read, Write};
 
+use rayon::prelude::*;
 use thiserror::Error;
 
-use super::hash::GeometryHasher;
 use super::{Bvh, Node};
 
 /// First bytes of every BVH file. The high first byte and the CR LF catch files mangled by
 /// text-mode transfers, as in PNG's signature.
 pub const MAGIC: [u8; 8] = *b"\x89PTBVH\r\n";
 
-/// The format version this build writes and reads.
-pub const FORMAT_VERSION: u32 = 1;
+/// The format version this build writes and reads. Version 2 (issue 19) keys the file by
+/// its inputs' bytes, checksums with xxh3 and appends the prepared patches.
+pub const FORMAT_VERSION: u32 = 2;
 
 const HEADER_LEN: usize = 36;
 const NODE_WORDS: usize = size_of::<Node>() / 4;
+
+/// Bytes per checksum chunk: chunks are hashed on all cores (a 200 MB file in a few
+/// milliseconds), then their digests once more.
+const CHECKSUM_CHUNK: usize = 1 << 20;
 
 /// Why a BVH file was refused.
 #[derive(Debug, Error)]
@@ -40,11 +47,11 @@ pub enum BvhFileError {
     #[error("byte 0: not a patchtrace BVH file (wrong magic number)")]
     NotBvh,
     #[error(
-        "byte 8: BVH file format version {found} is not supported (this build reads version {supported})"
+        "byte 8: BVH file format version {found} is not supported (this build reads version {supported}); rebuild with `patchtrace bvh`"
     )]
     UnsupportedVersion { found: u32, supported: u32 },
     #[error(
-        "the BVH file was built for different geometry (geometry hash {found:016x}, scene has {expected:016x}); rebuild with `patchtrace bvh`"
+        "the BVH file was built from different inputs (key {found:016x}, the scene's is {expected:016x}: a geometry file's bytes, a transform or an option changed); rebuild with `patchtrace bvh`"
     )]
     Stale { found: u64, expected: u64 },
     #[error("byte {at}: the BVH file is truncated: it ends inside the {what}")]
@@ -58,16 +65,32 @@ pub enum BvhFileError {
     Io(#[from] io::Error),
 }
 
+/// The checksum of BVH file sections: xxh3-64 (Collet, xxHash 0.8) of the little-endian
+/// xxh3-64 digests of each [`CHECKSUM_CHUNK`] bytes. Not cryptographic: it catches damage,
+/// not forgery (the structural checks after it keep forged files from doing harm).
+pub fn checksum(bytes: &[u8]) -> u64 {
+    let digests: Vec<u8> = bytes
+        .par_chunks(CHECKSUM_CHUNK)
+        .flat_map_iter(|c| xxhash_rust::xxh3::xxh3_64(c).to_le_bytes())
+        .collect();
+    xxhash_rust::xxh3::xxh3_64(&digests)
+}
+
 impl Bvh {
-    /// Writes the file for geometry with hash `geometry_hash`. Atomic replacement of a file on
+    /// Writes the tree section for inputs with key `key`. Atomic replacement of a file on
     /// disk is the caller's job (`scene::write::write_atomic`).
-    pub fn write(&self, w: &mut dyn Write, geometry_hash: u64) -> io::Result<()> {
+    pub fn write(&self, w: &mut dyn Write, key: u64) -> io::Result<()> {
+        w.write_all(&self.section(key))
+    }
+
+    /// The bytes [`write`](Bvh::write) writes.
+    pub(crate) fn section(&self, key: u64) -> Vec<u8> {
         let words: &[u32] = bytemuck::cast_slice(&self.nodes);
         let mut buf =
             Vec::with_capacity(HEADER_LEN + 4 * (words.len() + self.prim_indices.len()) + 8);
         buf.extend_from_slice(&MAGIC);
         buf.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
-        buf.extend_from_slice(&geometry_hash.to_le_bytes());
+        buf.extend_from_slice(&key.to_le_bytes());
         buf.extend_from_slice(&(self.nodes.len() as u64).to_le_bytes());
         buf.extend_from_slice(&(self.prim_indices.len() as u64).to_le_bytes());
         for word in words.iter().chain(&self.prim_indices) {
@@ -75,111 +98,99 @@ impl Bvh {
         }
         let checksum = checksum(&buf);
         buf.extend_from_slice(&checksum.to_le_bytes());
-        w.write_all(&buf)
+        buf
     }
 
-    /// Reads a file written by [`write`](Bvh::write), refusing it unless it is a BVH file of
-    /// this version, intact, built for geometry with hash `expected_geometry_hash`, and a
-    /// valid tree. No input makes this or a later traversal panic.
-    pub fn read(r: &mut dyn Read, expected_geometry_hash: u64) -> Result<Bvh, BvhFileError> {
-        let mut header = Vec::with_capacity(HEADER_LEN);
-        r.take(MAGIC.len() as u64).read_to_end(&mut header)?;
-        if !MAGIC.starts_with(&header) || header.is_empty() {
+    /// Reads a file written by [`write`](Bvh::write), refusing it unless it is a BVH tree
+    /// section of this version, intact, built for inputs with key `expected_key`, a valid
+    /// tree, and nothing more. No input makes this or a later traversal panic.
+    pub fn read(r: &mut dyn Read, expected_key: u64) -> Result<Bvh, BvhFileError> {
+        let mut bytes = Vec::new();
+        r.read_to_end(&mut bytes)?;
+        let (bvh, end) = Bvh::parse(&bytes, expected_key)?;
+        if end != bytes.len() {
+            return Err(BvhFileError::Corrupt(format!(
+                "byte {end}: extra bytes after the checksum"
+            )));
+        }
+        Ok(bvh)
+    }
+
+    /// Parses the tree section at the start of `bytes`, with the checks of
+    /// [`read`](Bvh::read), returning the tree and the offset where the section ends.
+    pub(crate) fn parse(bytes: &[u8], expected_key: u64) -> Result<(Bvh, usize), BvhFileError> {
+        let magic_len = bytes.len().min(MAGIC.len());
+        if magic_len == 0 || bytes[..magic_len] != MAGIC[..magic_len] {
             return Err(BvhFileError::NotBvh);
         }
-        if header.len() < MAGIC.len() {
-            return Err(BvhFileError::Truncated {
-                what: "magic number",
-                at: header.len(),
-            });
+        let truncated = |what, at| BvhFileError::Truncated { what, at };
+        if bytes.len() < MAGIC.len() {
+            return Err(truncated("magic number", bytes.len()));
         }
-        read_exactly(r, &mut header, HEADER_LEN - MAGIC.len(), ("header", 0))?;
-        let version = u32::from_le_bytes(field(&header, 8));
+        if bytes.len() < HEADER_LEN {
+            return Err(truncated("header", bytes.len()));
+        }
+        let version = u32::from_le_bytes(field(bytes, 8));
         if version != FORMAT_VERSION {
             return Err(BvhFileError::UnsupportedVersion {
                 found: version,
                 supported: FORMAT_VERSION,
             });
         }
-        let found_hash = u64::from_le_bytes(field(&header, 12));
-        let node_count = u64::from_le_bytes(field(&header, 20));
-        let prim_count = u64::from_le_bytes(field(&header, 28));
+        let found_key = u64::from_le_bytes(field(bytes, 12));
+        let node_count = u64::from_le_bytes(field(bytes, 20));
+        let prim_count = u64::from_le_bytes(field(bytes, 28));
         // A binary tree with non-empty leaves has at most 2n - 1 nodes; checking this first
-        // keeps a corrupt count from asking for an absurd read.
+        // keeps a corrupt count from overflowing the lengths below.
         if prim_count > u64::from(u32::MAX) || node_count > (2 * prim_count).saturating_sub(1) {
             return Err(BvhFileError::Corrupt(format!(
                 "byte 20: {node_count} nodes for {prim_count} primitives"
             )));
         }
-        let (node_count, prim_count) = (node_count as usize, prim_count as usize);
-        let mut data = header;
-        read_exactly(
-            r,
-            &mut data,
-            4 * (NODE_WORDS * node_count + prim_count),
-            ("tree data", 0),
-        )?;
-        let mut stored = Vec::with_capacity(8);
-        read_exactly(r, &mut stored, 8, ("checksum", data.len()))?;
-        if u64::from_le_bytes(field(&stored, 0)) != checksum(&data) {
+        // In u64, where these bounded counts cannot overflow on any host.
+        let data_end = HEADER_LEN as u64 + 4 * (NODE_WORDS as u64 * node_count + prim_count);
+        if (bytes.len() as u64) < data_end {
+            return Err(truncated("tree data", bytes.len()));
+        }
+        let (node_count, data_end) = (node_count as usize, data_end as usize);
+        if bytes.len() < data_end + 8 {
+            return Err(truncated("checksum", bytes.len()));
+        }
+        if u64::from_le_bytes(field(bytes, data_end)) != checksum(&bytes[..data_end]) {
             return Err(BvhFileError::Corrupt(format!(
-                "byte {}: checksum mismatch",
-                data.len()
+                "byte {data_end}: checksum mismatch"
             )));
         }
-        if r.read(&mut [0u8; 1])? != 0 {
-            return Err(BvhFileError::Corrupt(format!(
-                "byte {}: extra bytes after the checksum",
-                data.len() + 8
-            )));
-        }
-        if found_hash != expected_geometry_hash {
+        if found_key != expected_key {
             return Err(BvhFileError::Stale {
-                found: found_hash,
-                expected: expected_geometry_hash,
+                found: found_key,
+                expected: expected_key,
             });
         }
-        let words: Vec<u32> = data[HEADER_LEN..]
-            .chunks_exact(4)
-            .map(|b| u32::from_le_bytes(field(b, 0)))
-            .collect();
-        let (node_words, prim_indices) = words.split_at(NODE_WORDS * node_count);
-        let nodes = node_words
-            .chunks_exact(NODE_WORDS)
-            .map(|w| bytemuck::cast::<[u32; NODE_WORDS], Node>(field(w, 0)))
-            .collect();
-        Bvh::from_parts(nodes, prim_indices.to_vec())
+        let nodes_end = HEADER_LEN + size_of::<Node>() * node_count;
+        let nodes = words(&bytes[HEADER_LEN..nodes_end]);
+        let prim_indices = words(&bytes[nodes_end..data_end]);
+        Ok((Bvh::from_parts(nodes, prim_indices)?, data_end + 8))
     }
 }
 
-fn checksum(bytes: &[u8]) -> u64 {
-    let mut h = GeometryHasher::new();
-    h.write_bytes(bytes);
-    h.finish()
-}
-
-/// Appends exactly `len` more bytes from `r` to `buf`, which starts at byte `base` of the
-/// file (for the error's offset). Reads through `take` so that a corrupt length can only
-/// make the buffer as big as the file really is.
-fn read_exactly(
-    r: &mut dyn Read,
-    buf: &mut Vec<u8>,
-    len: usize,
-    (what, base): (&'static str, usize),
-) -> Result<(), BvhFileError> {
-    let want = buf.len() + len;
-    r.take(len as u64).read_to_end(buf)?;
-    if buf.len() < want {
-        return Err(BvhFileError::Truncated {
-            what,
-            at: base + buf.len(),
-        });
+/// Little-endian 4-byte words as `T` (nodes or indices): cast and copied where the host
+/// and alignment allow, converted word by word otherwise.
+fn words<T: bytemuck::Pod>(bytes: &[u8]) -> Vec<T> {
+    if cfg!(target_endian = "little")
+        && let Ok(cast) = bytemuck::try_cast_slice::<u8, T>(bytes)
+    {
+        return cast.to_vec();
     }
-    Ok(())
+    let words: Vec<u32> = bytes
+        .chunks_exact(4)
+        .map(|b| u32::from_le_bytes(field(b, 0)))
+        .collect();
+    bytemuck::cast_slice(&words).to_vec()
 }
 
 /// The `N` items of `s` from `at`; callers index within lengths checked beforehand.
-fn field<T: Copy, const N: usize>(s: &[T], at: usize) -> [T; N] {
+pub(crate) fn field<T: Copy, const N: usize>(s: &[T], at: usize) -> [T; N] {
     s[at..at + N]
         .try_into()
         .expect("length checked by the caller")

@@ -10,18 +10,18 @@
 //! - [`traverse`](Bvh::traverse) / [`traverse_any`](Bvh::traverse_any) /
 //!   [`traverse_leaves`](Bvh::traverse_leaves): stack-based, nearest-entry child first, no
 //!   allocation per ray, over a 4-wide form of the tree derived on construction (`wide`).
-//! - [`write`](Bvh::write) / [`read`](Bvh::read): a versioned little-endian file with a
-//!   geometry hash ([`GeometryHasher`]) and a checksum, validated so that no file can make
-//!   traversal panic or loop.
+//! - [`write`](Bvh::write) / [`read`](Bvh::read): a versioned little-endian file with the
+//!   key of the inputs it was built from and a [`checksum`], validated so that no file can
+//!   make traversal panic or loop; a scene's file appends its prepared patches
+//!   ([`crate::accel::mapped`]).
 
 mod build;
 mod file;
-mod hash;
 mod traverse;
 mod wide;
 
-pub use file::{BvhFileError, FORMAT_VERSION, MAGIC};
-pub use hash::GeometryHasher;
+pub(crate) use file::field;
+pub use file::{BvhFileError, FORMAT_VERSION, MAGIC, checksum};
 pub use traverse::TraversalStats;
 
 use crate::geom::Aabb;

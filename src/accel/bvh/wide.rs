@@ -48,17 +48,22 @@ pub(super) fn collapse(nodes: &[Node]) -> Vec<WideNode> {
 /// Appends the wide node whose children are the binary nodes `start` (or their descendants,
 /// pulled up) and its subtrees, returning its index.
 fn push(nodes: &[Node], start: &[usize], wide: &mut Vec<WideNode>) -> u32 {
-    let mut kids: Vec<usize> = start.to_vec();
-    while kids.len() < WIDTH {
-        let widest = (0..kids.len())
+    // A fixed array, not a Vec: a 320,000-patch tree has about 120,000 wide nodes, and
+    // `render --bvh` collapses the tree on every load.
+    let mut kids = [0usize; WIDTH];
+    let mut len = start.len();
+    kids[..len].copy_from_slice(start);
+    while len < WIDTH {
+        let widest = (0..len)
             .filter(|&slot| !nodes[kids[slot]].is_leaf())
             .max_by(|&a, &b| area(&nodes[kids[a]].bounds).total_cmp(&area(&nodes[kids[b]].bounds)));
         let Some(slot) = widest else { break };
-        let k = kids[slot];
-        let first = nodes[k].first as usize;
+        let first = nodes[kids[slot]].first as usize;
         kids[slot] = first;
-        kids.push(first + 1);
+        kids[len] = first + 1;
+        len += 1;
     }
+    let kids = &kids[..len];
     let at = wide.len();
     wide.push(WideNode {
         planes: [

@@ -1,0 +1,403 @@
+//! A scene's BVH file: the tree section ([`crate::accel::bvh`]) followed by the patch
+//! section, the scene's patches prepared for the kernels as fixed-size records that
+//! `render --bvh` maps (`memmap2`) and casts (`bytemuck`) in place: no parse, no per-patch
+//! allocation, and pages read only where rays go.
+//!
+//! Patch section layout, from the first multiple of 8 after the tree section's checksum
+//! (zero bytes before it), all little-endian:
+//!
+//! | offset | size | field |
+//! |---|---|---|
+//! | 0 | 8 | 1 if the records follow, 0 if the scene has geometry they cannot hold |
+//! | 8 | 8 | record count `u64` (the tree's primitive count when there are records) |
+//! | 16 | 8 | trim loops in the scene `u64` (for the effect line; none cuts a mapped patch) |
+//! | 24 | 8 | record size `u64` ([`PatchRecord`], 648) |
+//! | 32 | 648 × records | [`PatchRecord`]s, in primitive order |
+//! | … | 8 | [`checksum`] of the section before it |
+//!
+//! Records hold what the render reads of a patch: the `f32` net of the bicubic or bilinear
+//! fast path, its box, its (object, patch) number, and the `f64` control points and domain
+//! for normals and the `f64` and LG90 kernels. A scene with triangles, instances, patches
+//! its trim loops cut, or patches of the general (rational or other-degree) path has no
+//! records; its file holds the tree only, and the geometry is built from the scene.
+
+use std::fs::File;
+use std::io::{self, Write};
+use std::path::Path;
+
+use glam::{DVec3, DVec4, Vec3, Vec4};
+use memmap2::Mmap;
+use rayon::prelude::*;
+
+use super::bvh::{Bvh, BvhFileError, checksum};
+use super::patches::OwnedPatches;
+use crate::geom::bezier::ParamRect;
+use crate::geom::{Aabb, BezierPatch};
+use crate::kernel::subdivision::PreparedPatch;
+use crate::kernel::subdivision::bicubic::Net;
+use crate::kernel::subdivision::bilinear::BilinearNet;
+use crate::kernel::subdivision::prepared::Prepared;
+use crate::scene::LoadError;
+
+/// The key a scene's BVH file records: its inputs' key (`scene::source_key`) with what else
+/// decides the prepared patches: `--ignore-trims`, and whether this host prepares bilinear
+/// patches as bicubics (the AVX-512 path does), so that a file is never used with nets
+/// another host's kernel would not have made.
+pub fn key(source: u64, ignore_trims: bool) -> u64 {
+    #[cfg(target_arch = "x86_64")]
+    let elevated = crate::kernel::subdivision::avx512::available();
+    #[cfg(not(target_arch = "x86_64"))]
+    let elevated = false;
+    let mut bytes = source.to_le_bytes().to_vec();
+    bytes.extend([u8::from(ignore_trims), u8::from(elevated)]);
+    xxhash_rust::xxh3::xxh3_64(&bytes)
+}
+
+/// Most control points a record holds: a bicubic patch's.
+const POINTS: usize = 16;
+
+/// `kind` of a bicubic net whose registers hold rows (fixed v).
+const KIND_ROWS: u32 = 0;
+/// `kind` of a bicubic net whose registers hold columns (fixed u).
+const KIND_COLUMNS: u32 = 1;
+/// `kind` of a bilinear net.
+const KIND_BILINEAR: u32 = 2;
+
+const SECTION_HEADER: usize = 32;
+
+/// Bytes per patch record in the file.
+pub const RECORD_BYTES: usize = size_of::<PatchRecord>();
+
+/// One patch as the file stores it; `Pod`, so that the mapped bytes are records.
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
+pub(super) struct PatchRecord {
+    /// The kernel's net: a bicubic [`Net`]'s three blocks of four registers of four lanes,
+    /// or a [`BilinearNet`]'s three registers in the first twelve.
+    net: [f32; 48],
+    /// [`PreparedPatch::bounds`]: min xyz, max xyz.
+    bounds: [f32; 6],
+    kind: u32,
+    object: u32,
+    patch: u32,
+    /// Degree in u in the low 16 bits, in v in the high 16.
+    degrees: u32,
+    /// The patch's parameter rectangle: u0, u1, v0, v1.
+    domain: [f64; 4],
+    /// Control points x y z, u fastest, the first (du + 1)(dv + 1) used (weights are 1).
+    points: [f64; 3 * POINTS],
+}
+
+impl PatchRecord {
+    /// The record of an untrimmed patch, `None` for one of the general path or rational.
+    fn new(
+        prepared: &PreparedPatch,
+        original: &BezierPatch,
+        (object, patch): (u32, u32),
+    ) -> Option<PatchRecord> {
+        if original.is_rational() || original.point_count() > POINTS {
+            return None;
+        }
+        let mut net = [0.0; 48];
+        let kind = match &prepared.data {
+            Prepared::Bicubic(n) => {
+                let lanes = n.xyz.iter().flatten().flat_map(|r| r.to_array());
+                net.iter_mut().zip(lanes).for_each(|(d, s)| *d = s);
+                if n.transposed {
+                    KIND_COLUMNS
+                } else {
+                    KIND_ROWS
+                }
+            }
+            Prepared::Bilinear(n) => {
+                let lanes = n.xyz.iter().flat_map(|r| r.to_array());
+                net.iter_mut().zip(lanes).for_each(|(d, s)| *d = s);
+                KIND_BILINEAR
+            }
+            Prepared::General { .. } => return None,
+        };
+        let b = prepared.bounds();
+        let d = original.domain();
+        let mut points = [0.0; 3 * POINTS];
+        let coords = original.euclidean_points().flat_map(|p| p.to_array());
+        points.iter_mut().zip(coords).for_each(|(d, s)| *d = s);
+        Some(PatchRecord {
+            net,
+            bounds: [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z],
+            kind,
+            object,
+            patch,
+            degrees: original.degree_u() as u32 | (original.degree_v() as u32) << 16,
+            domain: [d.u0, d.u1, d.v0, d.v1],
+            points,
+        })
+    }
+
+    fn degrees(&self) -> (usize, usize) {
+        (
+            (self.degrees & 0xffff) as usize,
+            (self.degrees >> 16) as usize,
+        )
+    }
+
+    fn bounds(&self) -> Aabb {
+        let b = &self.bounds;
+        Aabb {
+            min: Vec3::new(b[0], b[1], b[2]),
+            max: Vec3::new(b[3], b[4], b[5]),
+        }
+    }
+
+    fn prepared(&self) -> PreparedPatch {
+        let reg = |at: usize| Vec4::from_slice(&self.net[at..at + 4]);
+        let data = match self.kind {
+            KIND_BILINEAR => Prepared::Bilinear(BilinearNet {
+                xyz: [reg(0), reg(4), reg(8)],
+            }),
+            kind => Prepared::Bicubic(Net {
+                xyz: [0, 16, 32].map(|c| [0, 4, 8, 12].map(|r| reg(c + r))),
+                transposed: kind == KIND_COLUMNS,
+            }),
+        };
+        PreparedPatch {
+            data,
+            bounds: self.bounds(),
+        }
+    }
+
+    /// The `f64` patch. Records are validated when the file is opened (degrees, point count);
+    /// points that are not finite (only in a file forged past its checksum) give the unit
+    /// square, so that no input can make this fail.
+    fn original(&self) -> BezierPatch {
+        let (du, dv) = self.degrees();
+        let n = (du + 1) * (dv + 1);
+        let points: Vec<DVec3> = self.points[..3 * n]
+            .chunks_exact(3)
+            .map(DVec3::from_slice)
+            .collect();
+        let [u0, u1, v0, v1] = self.domain;
+        BezierPatch::from_points(du, dv, &points)
+            .map(|p| p.with_domain(ParamRect { u0, u1, v0, v1 }))
+            .unwrap_or_else(|_| unit_square())
+    }
+
+    /// Why this record cannot be used with a scene of `objects` objects, if it cannot.
+    fn fault(&self, objects: usize) -> Option<String> {
+        let (du, dv) = self.degrees();
+        if !(1..=3).contains(&du) || !(1..=3).contains(&dv) {
+            return Some(format!("degrees {du} × {dv} outside 1..=3"));
+        }
+        if self.kind > KIND_BILINEAR {
+            return Some(format!("unknown net kind {}", self.kind));
+        }
+        if self.object as usize >= objects {
+            return Some(format!(
+                "object {} in a scene of {objects} objects",
+                self.object
+            ));
+        }
+        None
+    }
+}
+
+fn unit_square() -> BezierPatch {
+    let corners = [
+        DVec4::new(0.0, 0.0, 0.0, 1.0),
+        DVec4::X + DVec4::W,
+        DVec4::Y + DVec4::W,
+        DVec4::ONE.with_z(0.0),
+    ];
+    BezierPatch::new(1, 1, corners.to_vec()).expect("a valid unit square")
+}
+
+/// The patch records of `patches`, or `None` when any patch cannot be mapped (trimmed,
+/// general path, rational).
+pub(super) fn records(patches: &OwnedPatches) -> Option<Vec<PatchRecord>> {
+    if patches.trims.iter().any(Option::is_some) {
+        return None;
+    }
+    (0..patches.prepared.len())
+        .into_par_iter()
+        .map(|i| PatchRecord::new(&patches.prepared[i], &patches.originals[i], patches.ids[i]))
+        .collect()
+}
+
+/// Writes the file: `bvh`'s tree section with `key`, then the patch section with `records`
+/// (or none) and the scene's `trim_loops`.
+pub(super) fn write(
+    w: &mut dyn Write,
+    bvh: &Bvh,
+    key: u64,
+    records: Option<&[PatchRecord]>,
+    trim_loops: usize,
+) -> io::Result<()> {
+    let tree = bvh.section(key);
+    w.write_all(&tree)?;
+    w.write_all(&vec![0u8; tree.len().next_multiple_of(8) - tree.len()])?;
+    let has_records = records.is_some();
+    let records = records.unwrap_or_default();
+    let body: &[u8] = bytemuck::cast_slice(records);
+    let mut section = Vec::with_capacity(SECTION_HEADER + body.len());
+    for field in [
+        u64::from(has_records),
+        records.len() as u64,
+        trim_loops as u64,
+        size_of::<PatchRecord>() as u64,
+    ] {
+        section.extend_from_slice(&field.to_le_bytes());
+    }
+    section.extend_from_slice(body);
+    let sum = checksum(&section);
+    w.write_all(&section)?;
+    w.write_all(&sum.to_le_bytes())
+}
+
+/// The patches of a mapped file.
+pub struct MappedPatches {
+    map: Mmap,
+    /// Byte offset of the first record.
+    start: usize,
+    count: usize,
+}
+
+impl MappedPatches {
+    fn records(&self) -> &[PatchRecord] {
+        // Size and alignment were checked by `open` on this same mapping.
+        bytemuck::cast_slice(
+            &self.map[self.start..self.start + self.count * size_of::<PatchRecord>()],
+        )
+    }
+
+    pub(super) fn len(&self) -> usize {
+        self.count
+    }
+
+    pub(super) fn prepared(&self, i: usize) -> PreparedPatch {
+        self.records()[i].prepared()
+    }
+
+    pub(super) fn bounds(&self, i: usize) -> Aabb {
+        self.records()[i].bounds()
+    }
+
+    pub(super) fn original(&self, i: usize) -> BezierPatch {
+        self.records()[i].original()
+    }
+
+    pub(super) fn id(&self, i: usize) -> (u32, u32) {
+        let r = &self.records()[i];
+        (r.object, r.patch)
+    }
+}
+
+/// An opened BVH file: the tree, the mapped patches when the file has them (and the host
+/// is little-endian, the byte order of the records), and the scene's trim loop count.
+pub struct BvhFile {
+    pub bvh: Bvh,
+    pub patches: Option<MappedPatches>,
+    pub trim_loops: usize,
+}
+
+/// Opens the BVH file at `path` for a scene with key `key` and `objects` objects, refusing
+/// a file of another version, built from other inputs, damaged (the byte offset of the
+/// fault), or whose records do not fit the scene. No file makes this or a later query
+/// panic or read out of bounds: every size, offset, alignment and index is checked before
+/// the bytes are cast.
+pub fn open(path: &Path, key: u64, objects: usize) -> Result<BvhFile, LoadError> {
+    let invalid = |e: BvhFileError| LoadError::invalid(path, e.to_string());
+    let file = File::open(path).map_err(|e| LoadError::io(path, e))?;
+    // SAFETY: the mapping is read-only and private to this process; as for every reader of
+    // mapped files (ripgrep, the linker), another process truncating or rewriting the file
+    // while it is mapped is outside what we guard against. `patchtrace bvh` itself never
+    // rewrites a file in place: it writes a temporary file and renames it.
+    let map = unsafe { Mmap::map(&file) }.map_err(|e| LoadError::io(path, e))?;
+    let (bvh, tree_end) = Bvh::parse(&map, key).map_err(invalid)?;
+    let at = tree_end.next_multiple_of(8);
+    let truncated = |what| {
+        invalid(BvhFileError::Truncated {
+            what,
+            at: map.len(),
+        })
+    };
+    if map.len() < at + SECTION_HEADER {
+        return Err(truncated("patch section header"));
+    }
+    let word = |k: usize| u64::from_le_bytes(super::bvh::field(&map, at + 8 * k));
+    let (has_records, count, trim_loops, record_size) = (word(0), word(1), word(2), word(3));
+    let corrupt = |offset: usize, what: String| {
+        invalid(BvhFileError::Corrupt(format!("byte {offset}: {what}")))
+    };
+    if has_records > 1 {
+        return Err(corrupt(at, format!("patch section flag {has_records}")));
+    }
+    if record_size != size_of::<PatchRecord>() as u64 {
+        return Err(corrupt(
+            at + 24,
+            format!(
+                "patch records of {record_size} bytes, expected {}",
+                size_of::<PatchRecord>()
+            ),
+        ));
+    }
+    let expected = if has_records == 1 {
+        bvh.prim_count() as u64
+    } else {
+        0
+    };
+    if count != expected {
+        return Err(corrupt(
+            at + 8,
+            format!(
+                "{count} patch records for a tree of {} primitives",
+                bvh.prim_count()
+            ),
+        ));
+    }
+    let start = at + SECTION_HEADER;
+    let end = start + count as usize * size_of::<PatchRecord>();
+    if map.len() < end {
+        return Err(truncated("patch records"));
+    }
+    if map.len() < end + 8 {
+        return Err(truncated("patch section checksum"));
+    }
+    if u64::from_le_bytes(super::bvh::field(&map, end)) != checksum(&map[at..end]) {
+        return Err(corrupt(end, "patch section checksum mismatch".into()));
+    }
+    if map.len() > end + 8 {
+        return Err(corrupt(
+            end + 8,
+            "extra bytes after the patch section".into(),
+        ));
+    }
+    let trim_loops = usize::try_from(trim_loops).unwrap_or(usize::MAX);
+    if has_records == 0 || cfg!(target_endian = "big") {
+        return Ok(BvhFile {
+            bvh,
+            patches: None,
+            trim_loops,
+        });
+    }
+    let records: &[PatchRecord] = bytemuck::try_cast_slice(&map[start..end]).map_err(|e| {
+        corrupt(
+            start,
+            format!("patch records cannot be read in place ({e:?})"),
+        )
+    })?;
+    let fault = records
+        .par_iter()
+        .enumerate()
+        .find_map_first(|(i, r)| r.fault(objects).map(|f| (i, f)));
+    if let Some((i, f)) = fault {
+        return Err(corrupt(
+            start + i * size_of::<PatchRecord>(),
+            format!("patch record {i}: {f}"),
+        ));
+    }
+    let count = count as usize;
+    Ok(BvhFile {
+        bvh,
+        patches: Some(MappedPatches { map, start, count }),
+        trim_loops,
+    })
+}

@@ -1,0 +1,291 @@
+//! Issue 19, big unique scenes: the BVH file with the prepared patches, mapped by
+//! `render --bvh`, renders the bytes a fresh build renders; it is refused as stale when an
+//! input file's bytes or a transform change (and not when only a material does), refused
+//! with a byte offset when truncated or damaged, never with a panic; and the parallel
+//! build gives a valid tree, the same for one thread as for two.
+
+mod bvh_support;
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use bvh_support::{Rng, random_boxes};
+use common::{render, run, stderr, testdata};
+use glam::Vec3;
+use patchtrace::accel::bvh::{Bvh, checksum};
+use patchtrace::accel::mapped;
+use patchtrace::accel::scene::{FromFile, Precision, QueryStats, SceneGeometry};
+use patchtrace::geom::{Aabb, Ray};
+use patchtrace::kernel::subdivision::SubdivisionConfig;
+use patchtrace::scene::{LoadOptions, load_scene_keyed};
+
+/// Three teapots from one `.bpt` file, each placed by its own transform (so 96 distinct
+/// patches in world space), and a bilinear floor written inline.
+fn scene(dir: &Path, scale: &str, material: &str) -> PathBuf {
+    std::fs::copy(testdata("teapot.bpt"), dir.join("teapot.bpt")).unwrap();
+    let ron = format!(
+        r#"Scene(
+    camera: (eye: (0, -12, 6), look_at: (0, 0, 1), up: (0, 0, 1), fov_y: 40, width: 32, height: 32),
+    lights: [Point(position: (6, -6, 10), intensity: (1, 1, 1))],
+    materials: {{ "pink": (diffuse: ({material}, 0.5, 0.6), specular: 0.6, shininess: 40) }},
+    objects: [
+        (geometry: File("teapot.bpt"), material: "pink", transform: [Translate(-3, 0, 0)]),
+        (geometry: File("teapot.bpt"), material: "pink", transform: [Scale({scale}), Rotate((0, 0, 1), 40)]),
+        (geometry: File("teapot.bpt"), material: "pink", transform: [Translate(3, 1, 0)]),
+        (geometry: Surfaces([Bezier(degree: (1, 1), points: [(-9, -9, 0), (9, -9, 0), (-9, 9, 0), (9, 9, 0)])]), material: "pink"),
+    ],
+)"#
+    );
+    let path = dir.join("three.ron");
+    std::fs::write(&path, ron).unwrap();
+    path
+}
+
+fn build(scene: &Path, bvh: &Path) -> String {
+    let o = run(&["bvh", scene.to_str().unwrap(), "-o", bvh.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    stderr(&o)
+}
+
+fn render_bytes(scene: &Path, out: &Path, extra: &[&str]) -> Vec<u8> {
+    let o = render(scene, out, (32, 32), extra);
+    assert!(o.status.success(), "{}", stderr(&o));
+    std::fs::read(out).unwrap()
+}
+
+/// `render --bvh` on `scene` with `bvh`, expected to be refused: exit code 2, no image,
+/// no panic; returns stderr.
+fn refused(scene: &Path, bvh: &Path) -> String {
+    let out = scene.with_extension("refused.png");
+    let o = render(scene, &out, (32, 32), &["--bvh", bvh.to_str().unwrap()]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(!out.exists());
+    err
+}
+
+#[test]
+fn the_mapped_file_renders_the_bytes_of_a_fresh_build() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene(dir.path(), "1.2", "0.9");
+    let bvh = dir.path().join("three.bvh");
+    let said = build(&scene, &bvh);
+    assert!(said.contains("with the prepared patches"), "{said}");
+    let fresh = render_bytes(&scene, &dir.path().join("fresh.png"), &[]);
+    let mapped = render_bytes(
+        &scene,
+        &dir.path().join("mapped.png"),
+        &["--bvh", bvh.to_str().unwrap()],
+    );
+    assert_eq!(fresh, mapped);
+    // The file holds every patch: 3 × 32 teapot patches and the floor.
+    let len = std::fs::metadata(&bvh).unwrap().len() as usize;
+    assert!(len > 97 * mapped::RECORD_BYTES, "{len} bytes");
+}
+
+#[test]
+fn with_defer_the_geometry_files_are_keyed_but_not_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene(dir.path(), "1.2", "0.9");
+    let (full, key) = load_scene_keyed(&scene, LoadOptions::default(), false).unwrap();
+    let (deferred, deferred_key) = load_scene_keyed(&scene, LoadOptions::default(), true).unwrap();
+    assert_eq!(key, deferred_key);
+    assert_eq!(full.objects.len(), deferred.objects.len());
+    assert_eq!(full.objects[0].bezier_patches().len(), 32);
+    // The file objects have no geometry; the inline floor keeps its patch.
+    let counts: Vec<usize> = deferred
+        .objects
+        .iter()
+        .map(|o| o.bezier_patches().len())
+        .collect();
+    assert_eq!(counts, [0, 0, 0, 1]);
+}
+
+#[test]
+fn a_changed_byte_or_transform_makes_the_file_stale_a_material_does_not() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene(dir.path(), "1.2", "0.9");
+    let bvh = dir.path().join("three.bvh");
+    build(&scene, &bvh);
+
+    // A material is not geometry: the file still serves.
+    let recoloured = self::scene(dir.path(), "1.2", "0.3");
+    render_bytes(
+        &recoloured,
+        &dir.path().join("ok.png"),
+        &["--bvh", bvh.to_str().unwrap()],
+    );
+
+    // A transform: stale.
+    let moved = self::scene(dir.path(), "1.25", "0.9");
+    assert!(refused(&moved, &bvh).contains("rebuild"));
+
+    // One byte of the geometry file, same size: stale.
+    let scene = self::scene(dir.path(), "1.2", "0.9");
+    let bpt = dir.path().join("teapot.bpt");
+    let mut bytes = std::fs::read(&bpt).unwrap();
+    let at = bytes
+        .iter()
+        .rposition(|b| b.is_ascii_digit() && *b != b'9')
+        .unwrap();
+    bytes[at] += 1;
+    std::fs::write(&bpt, &bytes).unwrap();
+    let err = refused(&scene, &bvh);
+    assert!(
+        err.contains("rebuild") && err.contains("different inputs"),
+        "{err}"
+    );
+}
+
+#[test]
+fn an_old_version_file_is_refused_with_rebuild_advice() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene(dir.path(), "1.2", "0.9");
+    let bvh = dir.path().join("three.bvh");
+    build(&scene, &bvh);
+    let mut bytes = std::fs::read(&bvh).unwrap();
+    bytes[8..12].copy_from_slice(&1u32.to_le_bytes());
+    std::fs::write(&bvh, &bytes).unwrap();
+    let err = refused(&scene, &bvh);
+    assert!(
+        err.contains("version 1") && err.contains("rebuild"),
+        "{err}"
+    );
+}
+
+/// Where the parts of a scene's BVH file start: (patch section, records, checksum).
+fn layout(bytes: &[u8]) -> (usize, usize, usize) {
+    let word = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap()) as usize;
+    let (nodes, prims) = (word(20), word(28));
+    let section = (36 + 32 * nodes + 4 * prims + 8).next_multiple_of(8);
+    let records = section + 32;
+    (
+        section,
+        records,
+        records + word(section + 8) * mapped::RECORD_BYTES,
+    )
+}
+
+#[test]
+fn truncated_and_damaged_files_are_refused_with_the_byte_offset() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene(dir.path(), "1.2", "0.9");
+    let bvh = dir.path().join("three.bvh");
+    build(&scene, &bvh);
+    let (loaded, source) = load_scene_keyed(&scene, LoadOptions::default(), true).unwrap();
+    let key = mapped::key(source, false);
+    let objects = loaded.objects.len();
+    let good = std::fs::read(&bvh).unwrap();
+    let open = |bytes: &[u8]| {
+        let path = dir.path().join("damaged.bvh");
+        std::fs::write(&path, bytes).unwrap();
+        mapped::open(&path, key, objects).map(|f| f.patches.is_some())
+    };
+    assert!(open(&good).unwrap());
+    let (section, records, end) = layout(&good);
+    assert_eq!(end + 8, good.len());
+
+    // Every cut, in steps that land in every part of the file, names where the file ends.
+    for len in (0..good.len())
+        .step_by(37)
+        .chain([section, records, end, end + 7])
+    {
+        let err = open(&good[..len]).unwrap_err().to_string();
+        let names_it =
+            err.contains(&format!("byte {len}:")) || (len == 0 && err.contains("byte 0"));
+        assert!(names_it, "length {len}: {err}");
+    }
+    // A flipped byte in a record fails the section's checksum, at the checksum's offset.
+    let mut flipped = good.clone();
+    flipped[records + 100] ^= 0x40;
+    let err = open(&flipped).unwrap_err().to_string();
+    assert!(
+        err.contains(&format!("byte {end}: patch section checksum")),
+        "{err}"
+    );
+
+    // A record naming an object the scene does not have, resealed: refused at the record.
+    let mut forged = good.clone();
+    let object_field = records + 4 * 48 + 4 * 6 + 4;
+    forged[object_field..object_field + 4].copy_from_slice(&99u32.to_le_bytes());
+    let sum = checksum(&forged[section..end]);
+    forged[end..].copy_from_slice(&sum.to_le_bytes());
+    let err = open(&forged).unwrap_err().to_string();
+    assert!(
+        err.contains(&format!("byte {records}: patch record 0: object 99")),
+        "{err}"
+    );
+
+    // Random damage to the patch section, resealed: never a panic, and geometry from a
+    // file that is accepted answers queries without one (in-process, so a panic fails).
+    let mut rng = Rng::new(19);
+    let precision = Precision::F32(SubdivisionConfig::default());
+    let path = dir.path().join("forged.bvh");
+    for _ in 0..40 {
+        let mut bytes = good.clone();
+        for _ in 0..1 + rng.next_u64() % 8 {
+            let at = section + (rng.next_u64() as usize) % (end - section);
+            bytes[at] = rng.next_u64() as u8;
+        }
+        let sum = checksum(&bytes[section..end]);
+        bytes[end..].copy_from_slice(&sum.to_le_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        if let Ok(FromFile::Mapped(geometry, _)) = SceneGeometry::open(&path, key, objects) {
+            for k in 0..64 {
+                let ray = Ray {
+                    origin: Vec3::new(-6.0 + 0.2 * k as f32, -12.0, 6.0),
+                    dir: Vec3::new(0.0, 12.0, -5.0),
+                    tmin: 0.0,
+                    tmax: f32::INFINITY,
+                };
+                let mut stats = QueryStats::default();
+                let _ = geometry.intersect(&ray, &precision, &mut stats);
+                let _ = geometry.occluded(&ray, &precision, &mut stats);
+            }
+        }
+    }
+}
+
+fn contains(outer: &Aabb, inner: &Aabb) -> bool {
+    outer.min.cmple(inner.min).all() && outer.max.cmpge(inner.max).all()
+}
+
+/// Every primitive in exactly one leaf, every child inside its parent's box, and each
+/// leaf's box the union of its primitives' boxes.
+fn assert_valid(bvh: &Bvh, boxes: &[Aabb]) {
+    let mut seen = vec![0u32; boxes.len()];
+    for n in bvh.nodes() {
+        if n.is_leaf() {
+            let prims = &bvh.prim_indices()[n.first as usize..(n.first + n.count) as usize];
+            let union = prims
+                .iter()
+                .fold(Aabb::EMPTY, |b, &p| b.union(&boxes[p as usize]));
+            assert_eq!(n.bounds, union);
+            prims.iter().for_each(|&p| seen[p as usize] += 1);
+        } else {
+            for c in [n.first, n.first + 1] {
+                assert!(contains(&n.bounds, &bvh.nodes()[c as usize].bounds));
+            }
+        }
+    }
+    assert!(seen.iter().all(|&s| s == 1));
+}
+
+#[test]
+fn the_parallel_build_is_valid_and_the_same_on_one_thread_and_two() {
+    // Enough boxes that the root range bins in parallel chunks (2^15) and the upper levels
+    // build their subtrees as parallel tasks (2^12).
+    let boxes = random_boxes(&mut Rng::new(7), 70_000);
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| Bvh::build(&boxes))
+    };
+    let (one, two) = (on(1), on(2));
+    assert_valid(&two, &boxes);
+    assert_eq!(one.nodes(), two.nodes());
+    assert_eq!(one.prim_indices(), two.prim_indices());
+}
