@@ -225,8 +225,9 @@ impl BezierPatch {
 
     /// Homogeneous point at (u, v), by de Casteljau.
     pub fn eval_homogeneous(&self, u: f64, v: f64) -> DVec4 {
-        let cols = self.curve_in_u_at(v);
-        de_casteljau_point(&cols, u)
+        let mut row = [DVec4::ZERO; MAX_DEGREE + 1];
+        let row = self.curve_in_u_at(v, &mut row);
+        de_casteljau_in_place(row, u)
     }
 
     /// Surface point at (u, v) in `f64`.
@@ -256,9 +257,25 @@ impl BezierPatch {
 
     /// Point and first partial derivatives `(S, ∂S/∂u, ∂S/∂v)` at (u, v), exact for
     /// rational patches (quotient rule on the homogeneous derivatives).
+    ///
+    /// Every hit's normal comes from here, so the rows and columns live on the stack: sized
+    /// for bicubic patches where they fit (the heap vectors they replace were a tenth of
+    /// the teapot render's time, BENCHMARKS.md, issue 19), for [`MAX_DEGREE`] otherwise.
+    /// The arithmetic is the same either way.
     pub fn derivatives(&self, u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
-        let (a, au) = curve_point_and_tangent(&self.curve_in_u_at(v), u);
-        let (_, av) = curve_point_and_tangent(&self.curve_in_v_at(u), v);
+        if self.degree_u.max(self.degree_v) <= 3 {
+            self.derivatives_in::<4>(u, v)
+        } else {
+            self.derivatives_in::<{ MAX_DEGREE + 1 }>(u, v)
+        }
+    }
+
+    /// [`BezierPatch::derivatives`] with rows and columns of capacity `N`, at least the
+    /// larger degree plus one.
+    fn derivatives_in<const N: usize>(&self, u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
+        let (mut row, mut column) = ([DVec4::ZERO; N], [DVec4::ZERO; N]);
+        let (a, au) = curve_point_and_tangent(self.curve_in_u_at(v, &mut row), u);
+        let (_, av) = curve_point_and_tangent(self.curve_in_v_at(u, &mut column), v);
         let s = dehomogenize(a);
         let su = (au.truncate() - s * au.w) / a.w;
         let sv = (av.truncate() - s * av.w) / a.w;
@@ -368,25 +385,38 @@ impl BezierPatch {
         }
     }
 
-    /// The row of homogeneous points of the u-curve at parameter v.
-    fn curve_in_u_at(&self, v: f64) -> Vec<DVec4> {
-        let nu = self.degree_u + 1;
-        (0..nu)
-            .map(|i| {
-                let col: Vec<DVec4> = (0..=self.degree_v)
-                    .map(|j| self.points[j * nu + i])
-                    .collect();
-                de_casteljau_point(&col, v)
-            })
-            .collect()
+    /// The row of homogeneous points of the u-curve at parameter v, written to the start
+    /// of `row` (at least `degree_u + 1` long).
+    fn curve_in_u_at<'a, const N: usize>(
+        &self,
+        v: f64,
+        row: &'a mut [DVec4; N],
+    ) -> &'a mut [DVec4] {
+        let (nu, nv) = (self.degree_u + 1, self.degree_v + 1);
+        let mut work = [DVec4::ZERO; N];
+        for (i, out) in row[..nu].iter_mut().enumerate() {
+            for (j, w) in work[..nv].iter_mut().enumerate() {
+                *w = self.points[j * nu + i];
+            }
+            *out = de_casteljau_in_place(&mut work[..nv], v);
+        }
+        &mut row[..nu]
     }
 
-    /// The column of homogeneous points of the v-curve at parameter u.
-    fn curve_in_v_at(&self, u: f64) -> Vec<DVec4> {
-        let nu = self.degree_u + 1;
-        (0..=self.degree_v)
-            .map(|j| de_casteljau_point(&self.points[j * nu..(j + 1) * nu], u))
-            .collect()
+    /// The column of homogeneous points of the v-curve at parameter u, written to the
+    /// start of `column` (at least `degree_v + 1` long).
+    fn curve_in_v_at<'a, const N: usize>(
+        &self,
+        u: f64,
+        column: &'a mut [DVec4; N],
+    ) -> &'a mut [DVec4] {
+        let (nu, nv) = (self.degree_u + 1, self.degree_v + 1);
+        let mut work = [DVec4::ZERO; N];
+        for (j, out) in column[..nv].iter_mut().enumerate() {
+            work[..nu].copy_from_slice(&self.points[j * nu..(j + 1) * nu]);
+            *out = de_casteljau_in_place(&mut work[..nu], u);
+        }
+        &mut column[..nv]
     }
 }
 
@@ -412,7 +442,12 @@ pub(crate) fn dehomogenize(p: DVec4) -> DVec3 {
 
 /// De Casteljau evaluation of a homogeneous curve at t.
 pub(crate) fn de_casteljau_point(points: &[DVec4], t: f64) -> DVec4 {
-    let mut work: Vec<DVec4> = points.to_vec();
+    de_casteljau_in_place(&mut points.to_vec(), t)
+}
+
+/// [`de_casteljau_point`] in place (`work` holds the
+/// control points and is overwritten).
+fn de_casteljau_in_place(work: &mut [DVec4], t: f64) -> DVec4 {
     let n = work.len();
     for k in 1..n {
         for i in 0..n - k {
@@ -436,10 +471,10 @@ pub(crate) fn de_casteljau_generic<T: Real>(work: &mut [[T; 4]], t: T) -> [T; 4]
 }
 
 /// Point and first derivative of a homogeneous Bézier curve at t: the last de Casteljau
-/// step's two points give the tangent `n (b1 - b0)`.
-fn curve_point_and_tangent(points: &[DVec4], t: f64) -> (DVec4, DVec4) {
-    let n = points.len() - 1;
-    let mut work = points.to_vec();
+/// step's two points give the tangent `n (b1 - b0)`. `work` holds the control points and
+/// is overwritten.
+fn curve_point_and_tangent(work: &mut [DVec4], t: f64) -> (DVec4, DVec4) {
+    let n = work.len() - 1;
     for k in 1..n {
         for i in 0..=n - k {
             work[i] = work[i].lerp(work[i + 1], t);

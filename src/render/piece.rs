@@ -98,6 +98,10 @@ pub fn write_png(path: &Path, info: &PieceInfo, rgba8: &[u8]) -> Result<(), Load
         let mut enc = png::Encoder::new(out, w.width(), w.height());
         enc.set_color(png::ColorType::Rgba);
         enc.set_depth(png::BitDepth::Eight);
+        // fdeflate's PNG-tuned compressor: the default zlib level took 4 % of the teapot
+        // render's CPU time, this 0.3 %, for files 1.44 times as large (106 KB against
+        // 74 KB at 512², BENCHMARKS.md, issue 19).
+        enc.set_compression(png::Compression::Fast);
         let text = |e: png::EncodingError| std::io::Error::other(e);
         enc.add_text_chunk(PROVENANCE_KEY.into(), info.provenance.clone())
             .map_err(text)?;

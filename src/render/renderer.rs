@@ -175,27 +175,28 @@ fn trace_pixel(
         };
         integrator.primary(&rays.ray_at(x, y, sx, sy), tally)
     };
-    let mut taken: Vec<Vec4> = Vec::new();
-    match job.samples {
-        SampleCount::Fixed(n) => taken.extend((0..n).map(|i| shade(i, n))),
+    // Fixed counts are summed as they come (no vector per pixel); adaptive sampling keeps
+    // its first samples to compare them. Either sum runs in sample order from zero.
+    let (sum, count) = match job.samples {
+        SampleCount::Fixed(n) => ((0..n).map(|i| shade(i, n)).sum::<Vec4>(), n),
         SampleCount::Adaptive { max } => {
             let first = ADAPTIVE_FIRST.min(max);
-            taken.extend((0..first).map(|i| shade(i, max)));
+            let mut taken: Vec<Vec4> = (0..first).map(|i| shade(i, max)).collect();
             if disagree(&taken) {
                 taken.extend((first..max).map(|i| shade(i, max)));
             }
+            (taken.iter().copied().sum(), taken.len() as u32)
         }
-    }
-    let sum: Vec4 = taken.iter().copied().sum();
+    };
     let hit = job
         .hits
         .then(|| centre_hit(integrator, rays, x, y))
         .flatten()
         .map(Box::new);
     PixelResult {
-        color: sum / taken.len() as f32,
+        color: sum / count as f32,
         splits: (tally.splits() - before).min(u32::MAX as u64) as u32,
-        samples: taken.len() as u32,
+        samples: count,
         hit,
     }
 }
