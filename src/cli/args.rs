@@ -501,10 +501,13 @@ pub struct TessellateArgs {
     /// 4608 or 131072 as in Dammertz Tables 2.1–2.4). The default mode, with 512.
     #[arg(long, value_name = "N")]
     pub triangles_per_patch: Option<u32>,
-    /// Uniform grid of U×V quads per patch.
+    /// Uniform grid of U×V quads per patch. A Catmull–Clark cage (`--subdivide`,
+    /// `Subdivision(..)`) is sampled per quad after the first step instead, on a square
+    /// grid of the larger of U and V (its quads meet turned), at the limit surface.
     #[arg(long, value_name = "U,V", value_parser = parse_grid)]
     pub grid: Option<(u32, u32)>,
-    /// Adaptive, crack-free tessellation with this chord-height tolerance (scene units).
+    /// Adaptive, crack-free tessellation with this chord-height tolerance (scene units);
+    /// for a Catmull–Clark cage the finest count any quad needs, on every quad.
     #[arg(long, value_name = "DISTANCE")]
     pub tolerance: Option<f64>,
     /// Print the report as JSON.

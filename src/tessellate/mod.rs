@@ -17,6 +17,7 @@
 mod edge;
 pub mod gaps;
 mod stitch;
+mod subdivision;
 mod trimmed;
 pub mod write;
 
@@ -237,9 +238,10 @@ fn object_within(
             }
             mesh
         }
-        Geometry::Subdivision(_) | Geometry::Instance(_) => {
-            tessellate_patches(&geometry.bezier_patches(), mode)?.mesh
+        Geometry::Subdivision(surface) => {
+            subdivision::tessellate_surface(surface, Plan::new(mode)?, budget, patch_done)?
         }
+        Geometry::Instance(_) => tessellate_patches(&geometry.bezier_patches(), mode)?.mesh,
     };
     let report = TessellationReport::of(&mesh);
     Ok((

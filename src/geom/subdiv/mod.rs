@@ -73,6 +73,16 @@ impl Piece {
         }
     }
 
+    /// The patch's `(u, v)` at quad-local `(u, v)`: the inverse of [`Piece::to_face`],
+    /// unclamped (outside [0, 1]² for a point the piece does not cover).
+    pub fn from_face(&self, u: f64, v: f64) -> (f64, f64) {
+        let d = (
+            (u - self.origin.0) / self.size,
+            (v - self.origin.1) / self.size,
+        );
+        rotate(4 - self.rot % 4, d)
+    }
+
     /// The quad-local parameters of the patch's `(u, v)`.
     pub fn to_face(&self, u: f64, v: f64) -> (f64, f64) {
         let (dx, dy) = rotate(self.rot, (u, v));
