@@ -10,23 +10,11 @@ use glam::DVec3;
 use patchtrace::accel::grid::DEFAULT_BUDGET_BYTES;
 use patchtrace::accel::scene::{Precision, QueryStats, SceneGeometry};
 use patchtrace::geom::Ray;
-use patchtrace::geom::subdiv::SubdivisionSurface;
 use patchtrace::geom::ulp::ulp_of;
 use patchtrace::kernel::subdivision::SubdivisionConfig;
 use patchtrace::scene::generate::SplitMix64;
 use patchtrace::scene::{Geometry, Object, Scene};
-use subdiv_common::{Poly, cube, hex_bipyramid, icosahedron, open_grid, torus};
-
-fn surface(cage: &Poly) -> SubdivisionSurface {
-    SubdivisionSurface::new(
-        cage.p.clone(),
-        cage.f
-            .iter()
-            .map(|f| f.iter().map(|&v| v as u32).collect())
-            .collect(),
-    )
-    .expect("a valid cage")
-}
+use subdiv_common::{Poly, cube, hex_bipyramid, icosahedron, open_grid, surface, torus};
 
 /// A generic rotation applied to every test cage: the cages' symmetry planes would
 /// otherwise be coordinate planes, and rays aimed at points on them travel in the plane

@@ -15,18 +15,7 @@ use patchtrace::geom::subdiv::SubdivisionSurface;
 use patchtrace::geom::subdiv::adaptive::T_JUNCTION_OVERLAP_ULPS;
 use patchtrace::scene::{Geometry, Object, TriangleMesh};
 use patchtrace::tessellate::{TessellationMode, tessellate_object};
-use subdiv_common::{Poly, cube, hex_bipyramid, icosahedron, torus};
-
-fn surface(cage: &Poly) -> SubdivisionSurface {
-    SubdivisionSurface::new(
-        cage.p.clone(),
-        cage.f
-            .iter()
-            .map(|f| f.iter().map(|&v| v as u32).collect())
-            .collect(),
-    )
-    .expect("a valid cage")
-}
+use subdiv_common::{Poly, cube, hex_bipyramid, icosahedron, surface, torus};
 
 fn tessellate(s: &SubdivisionSurface, n: u32) -> TriangleMesh {
     let object = Object {

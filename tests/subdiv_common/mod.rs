@@ -7,6 +7,7 @@
 use std::collections::HashMap;
 
 use glam::DVec3;
+use patchtrace::geom::subdiv::SubdivisionSurface;
 
 /// A polygon mesh as face lists.
 #[derive(Clone, Debug)]
@@ -375,4 +376,16 @@ pub fn open_grid() -> Poly {
         })
         .collect();
     Poly { p, f }
+}
+
+/// The cage as the library's subdivision surface.
+pub fn surface(cage: &Poly) -> SubdivisionSurface {
+    SubdivisionSurface::new(
+        cage.p.clone(),
+        cage.f
+            .iter()
+            .map(|f| f.iter().map(|&v| v as u32).collect())
+            .collect(),
+    )
+    .expect("a valid cage")
 }
