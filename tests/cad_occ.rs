@@ -9,7 +9,7 @@ mod common;
 use std::f64::consts::FRAC_1_SQRT_2;
 
 use common::{testdata, trace_hits};
-use glam::DVec3;
+use glam::{DAffine3, DVec3};
 
 struct Aim {
     name: &'static str,
@@ -112,7 +112,24 @@ fn aims() -> Vec<Aim> {
 }
 
 fn check(file: &str, normals: bool) {
-    let aims = aims();
+    check_placed(file, normals, aims(), &[DAffine3::IDENTITY]);
+}
+
+/// [`check`] for the part placed by each of `placements`, with the aims placed alike.
+fn check_placed(file: &str, normals: bool, aims: Vec<Aim>, placements: &[DAffine3]) {
+    let aims: Vec<Aim> = placements
+        .iter()
+        .flat_map(|m| {
+            aims.iter().map(|a| Aim {
+                name: a.name,
+                origin: m.transform_point3(a.origin),
+                dir: m.transform_vector3(a.dir),
+                hit: a
+                    .hit
+                    .map(|(p, n)| (m.transform_point3(p), m.transform_vector3(n))),
+            })
+        })
+        .collect();
     let rays: Vec<(DVec3, DVec3)> = aims.iter().map(|a| (a.origin, a.dir)).collect();
     let hits = trace_hits(&testdata(file), &rays);
     for (a, got) in aims.iter().zip(&hits) {
@@ -155,6 +172,35 @@ fn occ_iges_brep_part_hits_every_face_kind_and_passes_its_holes() {
     // A 186 solid whose cylinders and dome (192, 196) carry parameter-space curves in
     // degrees, OpenCASCADE's convention.
     check("occ/bracket_occ_brep.igs", false);
+}
+
+/// OpenCASCADE's assembly of the bracket used three times (XCAF components, turned by 0°,
+/// 90° and 180° about z and moved): three instances of one shared part, and the vertical
+/// aims (which cannot reach another copy) hit each placed copy where the placement puts
+/// them, and pass its placed holes.
+#[test]
+fn occ_step_assembly_places_three_instances_of_one_part() {
+    let o = common::run(&["info", testdata("occ/brackets3_occ.step").to_str().unwrap()]);
+    let out = common::stdout(&o);
+    assert!(o.status.success(), "{}", common::stderr(&o));
+    assert_eq!(
+        out.matches("an instance of object 0's geometry").count(),
+        2,
+        "{out}"
+    );
+    let placements: Vec<DAffine3> = [(0.0, 0.0, 0.0), (60.0, 0.0, 90.0), (0.0, 50.0, 180.0)]
+        .iter()
+        .map(|&(dx, dy, degrees): &(f64, f64, f64)| {
+            DAffine3::from_translation(DVec3::new(dx, dy, 0.0))
+                * DAffine3::from_rotation_z(degrees.to_radians())
+        })
+        .collect();
+    let vertical = aims()
+        .into_iter()
+        .filter(|a| a.dir.x == 0.0 && a.dir.y == 0.0)
+        .collect::<Vec<_>>();
+    assert_eq!(vertical.len(), 8);
+    check_placed("occ/brackets3_occ.step", true, vertical, &placements);
 }
 
 /// Found by the mutation run (`benches/mutation_run.rs`): OpenCASCADE's two-solid file with

@@ -746,10 +746,10 @@ fn styled_item_colours_become_materials() {
 }
 
 /// Two occurrences of one part in an assembly (NEXT_ASSEMBLY_USAGE_OCCURRENCE,
-/// CONTEXT_DEPENDENT_SHAPE_REPRESENTATION, ITEM_DEFINED_TRANSFORMATION): flattened into
-/// two placed copies.
+/// CONTEXT_DEPENDENT_SHAPE_REPRESENTATION, ITEM_DEFINED_TRANSFORMATION): two instances of
+/// one shared geometry, each with its placement.
 #[test]
-fn assembly_occurrences_are_flattened_with_their_placements() {
+fn assembly_occurrences_are_instances_of_one_part_with_their_placements() {
     let mut w = StepWriter::default();
     let ax = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
     let plane = w.add(format!("PLANE('',#{ax})"));
@@ -792,7 +792,30 @@ fn assembly_occurrences_are_flattened_with_their_placements() {
     let m = read(&w.text());
     assert_eq!(m.report.occurrences, 2);
     assert_eq!(m.objects.len(), 2);
-    let boxes: Vec<_> = m.objects.iter().map(|o| o.bounds()).collect();
+    let parts: Vec<_> = m
+        .objects
+        .iter()
+        .map(|o| match &o.geometry {
+            Geometry::Instance(i) => i.geometry.clone(),
+            other => panic!("an occurrence of a shared part is an instance, found {other:?}"),
+        })
+        .collect();
+    assert!(
+        std::sync::Arc::ptr_eq(&parts[0], &parts[1]),
+        "both occurrences share one part"
+    );
+    // The shared part is the square in its own frame, in millimetres as written.
+    let own = parts[0].bounds();
+    assert!(
+        own.min.abs().max_element() < 1e-12
+            && (own.max - DVec3::new(1.0, 1.0, 0.0)).length() < 1e-12,
+        "{own:?}"
+    );
+    let boxes: Vec<_> = m
+        .objects
+        .iter()
+        .map(|o| o.geometry.resolved().bounds())
+        .collect();
     let near = |a: DVec3, b: DVec3| (a - b).length() < 1e-12;
     assert!(
         near(boxes[0].min, DVec3::new(10.0, 0.0, 0.0))

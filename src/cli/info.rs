@@ -33,13 +33,20 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
         s.nurbs_surfaces,
         s.triangles
     )?;
-    for o in &s.objects {
+    for (index, o) in s.objects.iter().enumerate() {
+        let shared = match o.shares_geometry_of {
+            Some(k) if k < index => format!(" (an instance of object {k}'s geometry)"),
+            Some(_) => " (an instance: its geometry is shared)".to_string(),
+            None => String::new(),
+        };
         writeln!(
             out,
-            "  {}: material \"{}\", {} surface(s), {} NURBS, {} patch(es), {} trim loop(s), {} triangle(s)",
+            "  {}{shared}: material \"{}\", {} surface(s), {} NURBS, {} patch(es), {} trim loop(s), {} triangle(s)",
             o.name, o.material, o.surfaces, o.nurbs_surfaces, o.patches, o.trim_loops, o.triangles
         )?;
-        for t in &o.trimmed_surfaces {
+        // A shared geometry's trims were listed with its first instance.
+        let listed = o.shares_geometry_of.is_some_and(|k| k < index);
+        for t in o.trimmed_surfaces.iter().filter(|_| !listed) {
             writeln!(
                 out,
                 "    surface {}: {} trim loop(s) ({} hole(s)), {} curve(s) as {} Bézier piece(s); patches: {} cut, {} whole, {} cut away",

@@ -52,6 +52,10 @@ pub struct SubdivisionSummary {
 #[derive(Debug, Serialize)]
 pub struct ObjectSummary {
     pub name: String,
+    /// For an instance, the first object (by index) placing the same shared geometry: the
+    /// geometry is held and prepared once for all of them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shares_geometry_of: Option<usize>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub subdivision: Option<SubdivisionSummary>,
     pub material: String,
@@ -109,11 +113,22 @@ fn trim_summary(k: usize, s: &Surface) -> Option<TrimSummary> {
     Some(t)
 }
 
+/// The first object of `scene` that is an instance of the same shared geometry as object
+/// `index`, if that object is an instance.
+fn first_sharing(scene: &Scene, index: usize) -> Option<usize> {
+    let shared = |k: usize| match &scene.objects[k].geometry {
+        Geometry::Instance(i) => Some(&i.geometry),
+        _ => None,
+    };
+    let mine = shared(index)?;
+    (0..=index).find(|&k| shared(k).is_some_and(|g| std::sync::Arc::ptr_eq(g, mine)))
+}
+
 pub fn summarize(scene: &Scene) -> SceneSummary {
     let mut degrees = BTreeMap::new();
     let mut objects = Vec::new();
     let (mut patches, mut rational, mut nurbs, mut triangles) = (0, 0, 0, 0);
-    for o in &scene.objects {
+    for (index, o) in scene.objects.iter().enumerate() {
         let bez = o.bezier_patches();
         for p in &bez {
             *degrees
@@ -152,6 +167,7 @@ pub fn summarize(scene: &Scene) -> SceneSummary {
         };
         objects.push(ObjectSummary {
             name: o.name.clone(),
+            shares_geometry_of: first_sharing(scene, index),
             subdivision,
             material: scene
                 .materials

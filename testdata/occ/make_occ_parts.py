@@ -55,3 +55,26 @@ c = BRepPrimAPI_MakeCone(gp_Ax2(gp_Pnt(30,0,0), gp_Dir(0,0,1)), 6, 2, 8).Shape()
 both = BRepAlgoAPI_Fuse(t, c).Shape()
 w = STEPControl_Writer(); w.Transfer(both, STEPControl_AsIs); w.Write("/tmp/occparts/torus_cone_occ.step")
 iw = IGESControl_Writer("MM", 0); iw.AddShape(both); iw.ComputeModel(); iw.Write("/tmp/occparts/torus_cone_occ.igs")
+# an assembly: the bracket used three times (XCAF components with their own locations), as
+# a CAD system writes a product structure; STEP and IGES (308/408 subfigures) from it
+from OCP.TDocStd import TDocStd_Document
+from OCP.TCollection import TCollection_ExtendedString
+from OCP.XCAFDoc import XCAFDoc_DocumentTool
+from OCP.STEPCAFControl import STEPCAFControl_Writer
+from OCP.IGESCAFControl import IGESCAFControl_Writer
+from OCP.TopLoc import TopLoc_Location
+from OCP.gp import gp_Trsf, gp_Vec, gp_Ax1
+import math
+doc = TDocStd_Document(TCollection_ExtendedString("XmlOcaf"))
+tool = XCAFDoc_DocumentTool.ShapeTool_s(doc.Main())
+asm = tool.NewShape()
+bracket = tool.AddShape(part, False)
+for k, (dx, dy, angle) in enumerate([(0, 0, 0), (60, 0, 90), (0, 50, 180)]):
+    t = gp_Trsf()
+    t.SetRotation(gp_Ax1(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), math.radians(angle))
+    m = gp_Trsf(); m.SetTranslation(gp_Vec(dx, dy, 0))
+    tool.AddComponent(asm, bracket, TopLoc_Location(m.Multiplied(t)))
+tool.UpdateAssemblies()
+sw = STEPCAFControl_Writer()
+sw.Transfer(doc, STEPControl_AsIs)
+sw.Write("/tmp/occparts/brackets3_occ.step")

@@ -488,6 +488,7 @@ impl RegisterNet for Net16 {
         cell: ParamCell,
         ray: &Ray16,
         tmax: f32,
+        near: f32,
     ) -> JumpOutcome<(Net16, ParamCell, GBox<f32>, f32)> {
         let Ray16::Axis { bounds, tmin } = *ray else {
             return JumpOutcome::Undecided;
@@ -496,12 +497,16 @@ impl RegisterNet for Net16 {
         // SAFETY: a Net16 exists only where AVX-512 is available (see `ray_registers`).
         unsafe {
             let max_levels = [lu, lv].map(|l| f32::MAX_LEVEL - l);
-            plan(&self.linearization(), max_levels).and_then(|jump| {
+            let (u0, v0, wu, wv) = cell.bounds();
+            let borders = [[u0 == 0.0, u0 + wu == 1.0], [v0 == 0.0, v0 + wv == 1.0]];
+            plan(&self.linearization(), max_levels, near, borders).and_then(|jump| {
                 let net = self.descend(&jump);
                 let b = by_bound(boxes(&net.regs, &net.regs));
                 match axis_pair(b, bounds, tmin, tmax) {
                     [(bbox, Some(t)), _] => JumpOutcome::Landed((net, jump.cell(cell), bbox, t)),
-                    _ => JumpOutcome::Empty,
+                    _ if jump.holds_near => JumpOutcome::Empty,
+                    // A near miss outside the sub-cell may still end in a final box.
+                    _ => JumpOutcome::Undecided,
                 }
             })
         }
@@ -809,6 +814,7 @@ mod tests {
                 levels,
                 index,
                 interior: false,
+                holds_near: true,
             };
             // SAFETY: as above.
             let got = unsafe { root.descend(&jump) };
@@ -857,6 +863,7 @@ mod tests {
                 levels,
                 index,
                 interior: true,
+                holds_near: true,
             };
             // SAFETY: as above.
             let got = points(&unsafe { root.descend(&jump) });

@@ -113,6 +113,10 @@ pub struct Jump {
     /// Whether the window lies inside the cell, away from its border: then the sub-net may
     /// be computed by [`restriction`] (see there).
     pub interior: bool,
+    /// Whether the window of points within [`plan`]'s `near` of the ray stays inside the
+    /// patch: only then does a sub-cell box that misses the ray prove that the halving
+    /// search would find nothing in the cell.
+    pub holds_near: bool,
 }
 
 impl Jump {
@@ -213,8 +217,16 @@ fn mean_and_deviation(d: &[[f32; 2]; 12]) -> ([f32; 2], [f32; 2]) {
 }
 
 /// The jump for a cell with linearisation `lin`, descending at most `max_levels` per
-/// direction.
-pub fn plan(lin: &Linearization, max_levels: [u8; 2]) -> JumpOutcome<Jump> {
+/// direction. `near` is the end game's floor and `borders[d]` says whether the cell's low
+/// and high side in direction `d` lie on the patch's border: there a surface that passes
+/// within `near` of the ray beyond the border must not be dropped (see the comment in the
+/// body).
+pub fn plan(
+    lin: &Linearization,
+    max_levels: [u8; 2],
+    near: f32,
+    borders: [[bool; 2]; 2],
+) -> JumpOutcome<Jump> {
     let f = |v: [f32; 2]| v.map(f64::from);
     let (c, du, dv, eu, ev) = (
         f(lin.centre),
@@ -255,16 +267,43 @@ pub fn plan(lin: &Linearization, max_levels: [u8; 2]) -> JumpOutcome<Jump> {
     let step_norm = (adj_c[0] * inv_a[0]).abs().max((adj_c[1] * inv_a[1]).abs());
     let rounding = ROUNDING_ULPS * f64::from(f32::EPSILON) * f64::from(lin.magnitude);
     let radius = (q * step_norm + rounding) / (1.0 - q);
+    // The same window for points within `near` of the ray. The halving search reports a
+    // final box that holds the ray, and at the end game's floor such a box may hold a
+    // surface that misses the ray by up to its diameter. Inside the patch that changes no
+    // answer (a crossing nearby is in some cell's narrow window), but beyond an edge of
+    // the patch it does: a ray crossing the exact surface a few ulps inside an open edge,
+    // which the ray-space transform's rounding moves just outside, is a hit of the halving
+    // search, and a jump that dropped that cell left a hole (`bench stability --full`,
+    // grid 2x2 corners+edges, 2 holes, and teapot corners+edges, 1). So where the narrow
+    // window leaves the cell across the patch's border but this one does not, the halving
+    // search decides instead.
+    let near_radius = (q * step_norm + rounding.max(f64::from(near))) / (1.0 - q);
     let w = a.map(|x| x * inv_det);
+    let centres = [0, 1].map(|d| 0.5 - step[d]);
+    let window = |d: usize, r: f64| (centres[d] - w[d] * r, centres[d] + w[d] * r);
+    let mut undecided = false;
+    for d in 0..2 {
+        let (lo, hi) = window(d, radius);
+        if !(hi >= 0.0 && lo <= 1.0) {
+            let (near_lo, near_hi) = window(d, near_radius);
+            let near_patch_edge = (hi < 0.0 && borders[d][0] && near_hi >= 0.0)
+                || (lo > 1.0 && borders[d][1] && near_lo <= 1.0);
+            if !near_patch_edge {
+                return JumpOutcome::Empty;
+            }
+            undecided = true;
+        }
+    }
+    if undecided {
+        return JumpOutcome::Undecided;
+    }
     let mut levels = [0u8; 2];
     let mut index = [0u64; 2];
     let mut interior = true;
+    let mut holds_near = true;
     for d in 0..2 {
-        let (centre, half_width) = (0.5 - step[d], w[d] * radius);
-        let (lo, hi) = (centre - half_width, centre + half_width);
-        if !(hi >= 0.0 && lo <= 1.0) {
-            return JumpOutcome::Empty;
-        }
+        let half_width = w[d] * radius;
+        let (lo, hi) = (centres[d] - half_width, centres[d] + half_width);
         interior &= lo > 0.0 && hi < 1.0;
         let k = max_levels[d];
         let scale = (1u64 << k) as f64;
@@ -277,12 +316,15 @@ pub fn plan(lin: &Linearization, max_levels: [u8; 2]) -> JumpOutcome<Jump> {
         let drop = 64 - (a ^ b).leading_zeros() as u8;
         levels[d] = k - drop;
         index[d] = a >> drop;
+        let (near_lo, near_hi) = window(d, near_radius);
+        holds_near &= !((borders[d][0] && near_lo < 0.0) || (borders[d][1] && near_hi > 1.0));
     }
     if levels[0] + levels[1] >= MIN_JUMP_LEVELS {
         JumpOutcome::Landed(Jump {
             levels,
             index,
             interior,
+            holds_near,
         })
     } else {
         JumpOutcome::Undecided
@@ -320,6 +362,36 @@ mod tests {
         })
     }
 
+    /// A linear patch whose crossing lies just beyond its u = 0 edge, by less than the end
+    /// game's floor: the halving search may end in a final box holding the ray there, so
+    /// the jump must leave the cell to it where that edge is the patch's border, and may
+    /// drop it where a neighbouring cell of the same patch continues the surface.
+    #[test]
+    fn a_near_miss_beyond_the_patch_border_is_left_to_the_halving_search() {
+        // F(u, v) = (u + 2e-5, v - 0.5): the crossing is at u = -2e-5, beyond the rounding
+        // allowance (32 ulps of the net's magnitude 1, 3.8e-6).
+        let lin = linearize(&linear_net([[1.0, 0.0], [0.0, 1.0]], [2e-5, -0.5]));
+        let border = [[true, false], [false, false]];
+        assert_eq!(
+            plan(&lin, [20, 20], 4e-5, [[false; 2]; 2]),
+            JumpOutcome::Empty
+        );
+        assert_eq!(plan(&lin, [20, 20], 4e-5, border), JumpOutcome::Undecided);
+        // Farther out than the floor, it is dropped at the border too.
+        assert_eq!(plan(&lin, [20, 20], 1e-5, border), JumpOutcome::Empty);
+        // A crossing just inside lands, but a miss of its sub-cell's box may not drop the
+        // cell: the window of near points reaches beyond the border.
+        let inside = linearize(&linear_net([[1.0, 0.0], [0.0, 1.0]], [-1e-5, -0.5]));
+        let JumpOutcome::Landed(jump) = plan(&inside, [20, 20], 4e-5, border) else {
+            panic!("the crossing is inside the cell");
+        };
+        assert!(!jump.holds_near);
+        let JumpOutcome::Landed(jump) = plan(&inside, [20, 20], 4e-5, [[false; 2]; 2]) else {
+            panic!("the crossing is inside the cell");
+        };
+        assert!(jump.holds_near);
+    }
+
     #[test]
     fn linear_patch_jumps_to_the_cell_of_its_root() {
         // Root where A (u, v) = -b, solved in f64.
@@ -331,7 +403,7 @@ mod tests {
         let v =
             (f64::from(a[0][0]) * f64::from(-b[1]) - f64::from(-b[0]) * f64::from(a[1][0])) / det;
         let lin = linearize(&linear_net(a, b));
-        let JumpOutcome::Landed(jump) = plan(&lin, [20, 20]) else {
+        let JumpOutcome::Landed(jump) = plan(&lin, [20, 20], 0.0, [[false; 2]; 2]) else {
             panic!("a linear patch is a contraction with its root inside");
         };
         assert!(holds(&jump, [u, v]), "{jump:?} {u} {v}");
@@ -427,7 +499,7 @@ mod tests {
                 continue;
             };
             let inside = root.iter().all(|r| (0.0..=1.0).contains(r));
-            match plan(&linearize(&xy), [20, 20]) {
+            match plan(&linearize(&xy), [20, 20], 0.0, [[false; 2]; 2]) {
                 JumpOutcome::Landed(jump) => {
                     jumped += 1;
                     assert!(

@@ -44,13 +44,16 @@ pub trait RegisterNet: Copy {
     /// Corner points `b(0,0)`, `b(n,0)`, `b(0,m)` for the split heuristics.
     fn corners(&self) -> Corners<f32>;
     /// The jump of [`super::jump`] from this net, whose cell is `cell`: where it lands,
-    /// the sub-cell's net, cell, box and entry `t` (clipped to `tmax`). Only nets in ray
-    /// space can jump.
+    /// the sub-cell's net, cell, box and entry `t` (clipped to `tmax`). `near` is the
+    /// end game's floor: the search may end in a final box of that L1 diameter around a
+    /// surface that passes that close to the ray, so the jump keeps such cells too. Only
+    /// nets in ray space can jump.
     fn jump(
         &self,
         _cell: ParamCell,
         _ray: &Self::RayRegisters,
         _tmax: f32,
+        _near: f32,
     ) -> JumpOutcome<(Self, ParamCell, GBox<f32>, f32)> {
         JumpOutcome::Undecided
     }
@@ -211,7 +214,7 @@ impl<N: RegisterNet> NetStack<f32> for RegisterStack<'_, N> {
     #[inline(always)]
     fn try_jump(&mut self, cell: ParamCell, tmax: f32) -> JumpOutcome<(ParamCell, GBox<f32>, f32)> {
         self.cur
-            .jump(cell, &self.ray, tmax)
+            .jump(cell, &self.ray, tmax, self.end_game_floor)
             .and_then(|(net, sub, bbox, t)| {
                 self.cur = net;
                 JumpOutcome::Landed((sub, bbox, t))

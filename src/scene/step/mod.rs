@@ -24,6 +24,7 @@ pub mod units;
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::Path;
+use std::sync::Arc;
 
 use glam::{DAffine3, DVec3};
 use rayon::prelude::*;
@@ -32,7 +33,7 @@ use self::entities::Resolver;
 use self::style::Colour;
 use self::units::Units;
 use crate::scene::error::{LoadError, ParseError};
-use crate::scene::model::{Geometry, Material, Object, Surface};
+use crate::scene::model::{Geometry, Instance, Material, Object, Surface};
 
 /// What reading a STEP file found beyond the geometry.
 #[derive(Clone, Debug, Default)]
@@ -290,8 +291,9 @@ pub fn read_step_str(path: &Path, src: &str) -> Result<StepModel, ParseError> {
         }
     }
     let mut palette: Vec<Colour> = Vec::new();
+    // Per occurrence and material, the surfaces in their representation's own frame.
     let mut groups: BTreeMap<(usize, usize), Vec<Surface>> = BTreeMap::new();
-    for (k, (occ, faces)) in occurrences.iter().zip(placed).enumerate() {
+    for (k, faces) in placed.into_iter().enumerate() {
         for (fid, colour) in faces {
             let Some(surface) = converted.get(&fid) else {
                 continue;
@@ -305,11 +307,13 @@ pub fn read_step_str(path: &Path, src: &str) -> Result<StepModel, ParseError> {
                 }
                 None => 0,
             };
-            let mut s = surface.clone();
-            s.transform(&(scale * occ.transform));
-            groups.entry((k, material)).or_default().push(s);
+            groups
+                .entry((k, material))
+                .or_default()
+                .push(surface.clone());
         }
     }
+    let geometries = placed_geometries(&occurrences, groups, scale);
     report.faces = converted.len();
     report.failed_faces.sort_by_key(|(id, _)| *id);
     report.max_projection_error *= report.units.length.factor;
@@ -326,21 +330,23 @@ pub fn read_step_str(path: &Path, src: &str) -> Result<StepModel, ParseError> {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let objects = groups
+    let objects = geometries
         .into_iter()
-        .map(|((k, material), surfaces)| {
+        .map(|((k, material), geometry)| {
             let occ = &occurrences[k];
             Object {
                 name: if occurrences.len() > 1 || material > 0 {
                     format!(
-                        "{stem} #{} {}",
-                        occ.representation, materials[material].name
+                        "{stem} #{} occurrence {} {}",
+                        occ.representation,
+                        k + 1,
+                        materials[material].name
                     )
                 } else {
                     stem.clone()
                 },
                 material,
-                geometry: Geometry::Surfaces(surfaces),
+                geometry,
             }
         })
         .collect();
@@ -349,6 +355,40 @@ pub fn read_step_str(path: &Path, src: &str) -> Result<StepModel, ParseError> {
         materials,
         report,
     })
+}
+
+/// Each occurrence's surfaces placed in the model by `scale` after the occurrence's
+/// transform. A part that occurs once is a placed copy; the occurrences of a part used more
+/// than once are instances of one geometry in the part's frame (Dammertz §3.3), so it is
+/// prepared, and its BVH built, once however often the assembly uses it.
+fn placed_geometries(
+    occurrences: &[assembly::Occurrence],
+    groups: BTreeMap<(usize, usize), Vec<Surface>>,
+    scale: DAffine3,
+) -> BTreeMap<(usize, usize), Geometry> {
+    let mut uses: HashMap<u64, usize> = HashMap::new();
+    for occ in occurrences {
+        *uses.entry(occ.representation).or_default() += 1;
+    }
+    let mut shared: HashMap<(u64, usize), Arc<Geometry>> = HashMap::new();
+    groups
+        .into_iter()
+        .map(|((k, material), surfaces)| {
+            let occ = &occurrences[k];
+            let placement = scale * occ.transform;
+            let geometry = if uses[&occ.representation] > 1 {
+                let part = shared
+                    .entry((occ.representation, material))
+                    .or_insert_with(|| Arc::new(Geometry::Surfaces(surfaces)));
+                Geometry::Instance(Instance::new(part.clone(), placement))
+            } else {
+                let mut g = Geometry::Surfaces(surfaces);
+                g.transform(&placement);
+                g
+            };
+            ((k, material), geometry)
+        })
+        .collect()
 }
 
 /// The entities of face `fid`; a face that is valid STEP but uses what the reader does not
@@ -387,7 +427,7 @@ pub fn load_geometry(path: &Path) -> Result<Geometry, LoadError> {
     let surfaces = model
         .objects
         .into_iter()
-        .flat_map(|o| match o.geometry {
+        .flat_map(|o| match o.geometry.resolved().into_owned() {
             Geometry::Surfaces(s) => s,
             _ => Vec::new(),
         })
