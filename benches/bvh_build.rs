@@ -5,8 +5,9 @@
 //!
 //! - build: what `patchtrace bvh` reports as "built in": collecting the patches, their
 //!   boxes, the tree and its wide form, and preparing the patches for the kernel;
-//! - load: what `render --bvh` does before rendering: reading the scene without its
-//!   geometry files, keying the inputs, mapping and checking the file.
+//! - load: what `render --bvh` does before rendering: mapping the file, reading the scene
+//!   (from the parse the file keeps) without its geometry files, keying the inputs and
+//!   checking the file.
 //!
 //! Run: `cargo bench --bench bvh_build` (or `-- COUNT` for another number of teapots).
 
@@ -20,6 +21,7 @@ use support::process_cpu_seconds;
 use patchtrace::accel::mapped;
 use patchtrace::accel::scene::{FromFile, SceneGeometry};
 use patchtrace::scene::generate::{TEAPOT_BPT, TeapotsSpec, teapots_scene};
+use patchtrace::scene::ron_format::parsed_scene;
 use patchtrace::scene::{LoadOptions, load_scene_keyed};
 
 /// Runs `f`, returning its value and its (wall, CPU) seconds.
@@ -58,12 +60,18 @@ fn main() {
             .trim()
     );
     for round in 1..=3 {
-        let (scene, source) =
-            load_scene_keyed(&scene_path, LoadOptions::default(), false).expect("scene loads");
+        let (scene, source) = load_scene_keyed(&scene_path, LoadOptions::default(), false, None)
+            .expect("scene loads");
         let (geometry, build_wall, build_cpu) = timed(|| SceneGeometry::build(&scene));
         let key = mapped::key(source, false);
+        let parsed = parsed_scene(&scene_path).expect("the scene's parse is kept");
         let with_patches = geometry
-            .save_bvh(&bvh_path, key, scene.trim_loop_count())
+            .save_bvh(
+                &bvh_path,
+                key,
+                scene.trim_loop_count(),
+                Some((parsed.0, &parsed.1)),
+            )
             .expect("file written");
         assert!(
             with_patches,
@@ -88,10 +96,15 @@ fn main() {
 
 /// What `render --bvh` does before it renders; the number of patches mapped.
 fn load(scene_path: &Path, bvh_path: &Path) -> usize {
+    let opened = mapped::map(bvh_path).expect("file maps");
+    let parsed = Some(opened.cached_scene());
     let (scene, source) =
-        load_scene_keyed(scene_path, LoadOptions::default(), true).expect("scene loads");
+        load_scene_keyed(scene_path, LoadOptions::default(), true, parsed).expect("scene loads");
     let key = mapped::key(source, false);
-    match SceneGeometry::open(bvh_path, key, scene.objects.len()).expect("file opens") {
+    let file = opened
+        .check(bvh_path, key, scene.objects.len())
+        .expect("file fits");
+    match SceneGeometry::from_file(file) {
         FromFile::Mapped(geometry, _) => geometry.patch_count(),
         FromFile::TreeOnly(_) => panic!("the file should hold the patches"),
     }

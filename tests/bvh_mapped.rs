@@ -17,6 +17,7 @@ use patchtrace::accel::mapped;
 use patchtrace::accel::scene::{FromFile, Precision, QueryStats, SceneGeometry};
 use patchtrace::geom::{Aabb, Ray};
 use patchtrace::kernel::subdivision::SubdivisionConfig;
+use patchtrace::scene::ron_format::parsed_scene;
 use patchtrace::scene::{LoadOptions, load_scene_keyed};
 
 /// Three teapots from one `.bpt` file, each placed by its own transform (so 96 distinct
@@ -88,8 +89,9 @@ fn the_mapped_file_renders_the_bytes_of_a_fresh_build() {
 fn with_defer_the_geometry_files_are_keyed_but_not_read() {
     let dir = tempfile::tempdir().unwrap();
     let scene = scene(dir.path(), "1.2", "0.9");
-    let (full, key) = load_scene_keyed(&scene, LoadOptions::default(), false).unwrap();
-    let (deferred, deferred_key) = load_scene_keyed(&scene, LoadOptions::default(), true).unwrap();
+    let (full, key) = load_scene_keyed(&scene, LoadOptions::default(), false, None).unwrap();
+    let (deferred, deferred_key) =
+        load_scene_keyed(&scene, LoadOptions::default(), true, None).unwrap();
     assert_eq!(key, deferred_key);
     assert_eq!(full.objects.len(), deferred.objects.len());
     assert_eq!(full.objects[0].bezier_patches().len(), 32);
@@ -154,16 +156,21 @@ fn an_old_version_file_is_refused_with_rebuild_advice() {
     );
 }
 
-/// Where the parts of a scene's BVH file start: (patch section, records, checksum).
-fn layout(bytes: &[u8]) -> (usize, usize, usize) {
+/// Where the parts of a scene's BVH file start: (patch section, records, its checksum,
+/// scene section), and the file's length by the layout in `accel::mapped`.
+fn layout(bytes: &[u8]) -> (usize, usize, usize, usize, usize) {
     let word = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap()) as usize;
     let (nodes, prims) = (word(20), word(28));
     let section = (36 + 32 * nodes + 4 * prims + 8).next_multiple_of(8);
     let records = section + 32;
+    let end = records + word(section + 8) * mapped::RECORD_BYTES;
+    let scene = end + 8;
     (
         section,
         records,
-        records + word(section + 8) * mapped::RECORD_BYTES,
+        end,
+        scene,
+        scene + 16 + word(scene + 8) + 8,
     )
 }
 
@@ -173,24 +180,31 @@ fn truncated_and_damaged_files_are_refused_with_the_byte_offset() {
     let scene = scene(dir.path(), "1.2", "0.9");
     let bvh = dir.path().join("three.bvh");
     build(&scene, &bvh);
-    let (loaded, source) = load_scene_keyed(&scene, LoadOptions::default(), true).unwrap();
+    let (loaded, source) = load_scene_keyed(&scene, LoadOptions::default(), true, None).unwrap();
     let key = mapped::key(source, false);
     let objects = loaded.objects.len();
     let good = std::fs::read(&bvh).unwrap();
     let open = |bytes: &[u8]| {
         let path = dir.path().join("damaged.bvh");
         std::fs::write(&path, bytes).unwrap();
-        mapped::open(&path, key, objects).map(|f| f.patches.is_some())
+        mapped::map(&path)
+            .and_then(|o| o.check(&path, key, objects))
+            .map(|f| f.patches.is_some())
     };
     assert!(open(&good).unwrap());
-    let (section, records, end) = layout(&good);
-    assert_eq!(end + 8, good.len());
+    let (section, records, end, scene_section, len) = layout(&good);
+    assert_eq!(len, good.len());
 
     // Every cut, in steps that land in every part of the file, names where the file ends.
-    for len in (0..good.len())
-        .step_by(37)
-        .chain([section, records, end, end + 7])
-    {
+    let parts = [
+        section,
+        records,
+        end,
+        end + 7,
+        scene_section,
+        scene_section + 16,
+    ];
+    for len in (0..good.len()).step_by(37).chain(parts) {
         let err = open(&good[..len]).unwrap_err().to_string();
         let names_it =
             err.contains(&format!("byte {len}:")) || (len == 0 && err.contains("byte 0"));
@@ -210,7 +224,7 @@ fn truncated_and_damaged_files_are_refused_with_the_byte_offset() {
     let object_field = records + 4 * 48 + 4 * 6 + 4;
     forged[object_field..object_field + 4].copy_from_slice(&99u32.to_le_bytes());
     let sum = checksum(&forged[section..end]);
-    forged[end..].copy_from_slice(&sum.to_le_bytes());
+    forged[end..end + 8].copy_from_slice(&sum.to_le_bytes());
     let err = open(&forged).unwrap_err().to_string();
     assert!(
         err.contains(&format!("byte {records}: patch record 0: object 99")),
@@ -229,9 +243,10 @@ fn truncated_and_damaged_files_are_refused_with_the_byte_offset() {
             bytes[at] = rng.next_u64() as u8;
         }
         let sum = checksum(&bytes[section..end]);
-        bytes[end..].copy_from_slice(&sum.to_le_bytes());
+        bytes[end..end + 8].copy_from_slice(&sum.to_le_bytes());
         std::fs::write(&path, &bytes).unwrap();
-        if let Ok(FromFile::Mapped(geometry, _)) = SceneGeometry::open(&path, key, objects) {
+        let opened = mapped::map(&path).and_then(|o| o.check(&path, key, objects));
+        if let Ok(FromFile::Mapped(geometry, _)) = opened.map(SceneGeometry::from_file) {
             for k in 0..64 {
                 let ray = Ray {
                     origin: Vec3::new(-6.0 + 0.2 * k as f32, -12.0, 6.0),
@@ -245,6 +260,45 @@ fn truncated_and_damaged_files_are_refused_with_the_byte_offset() {
             }
         }
     }
+}
+
+#[test]
+fn the_file_keeps_the_scene_parse_and_uses_it_only_for_unchanged_text() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene(dir.path(), "1.2", "0.9");
+    let (hash, json) = parsed_scene(&scene).expect("the scene's parse is kept");
+    let read = |parsed: Option<(u64, &[u8])>| {
+        let (s, key) = load_scene_keyed(&scene, LoadOptions::default(), true, parsed).unwrap();
+        (
+            format!("{:?}", (&s.camera, &s.lights, &s.materials, &s.objects)),
+            key,
+        )
+    };
+    // The kept parse gives the scene the text gives.
+    assert_eq!(read(Some((hash, &json))), read(None));
+    // It is what is read when the text's hash matches: a parse with another field of view
+    // shows through...
+    let text = String::from_utf8(json.clone()).unwrap();
+    assert!(text.contains("\"fov_y\":40.0"), "{text}");
+    let other = text.replace("\"fov_y\":40.0", "\"fov_y\":30.0");
+    let (s, _) = load_scene_keyed(
+        &scene,
+        LoadOptions::default(),
+        true,
+        Some((hash, other.as_bytes())),
+    )
+    .unwrap();
+    assert_eq!(s.camera.fov_y, 30.0);
+    // ...but not once the text changed, and JSON that does not parse is ignored.
+    let (s, _) = load_scene_keyed(
+        &scene,
+        LoadOptions::default(),
+        true,
+        Some((hash ^ 1, other.as_bytes())),
+    )
+    .unwrap();
+    assert_eq!(s.camera.fov_y, 40.0);
+    assert_eq!(read(Some((hash, b"{not json"))), read(None));
 }
 
 fn contains(outer: &Aabb, inner: &Aabb) -> bool {

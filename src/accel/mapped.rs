@@ -15,6 +15,11 @@
 //! | 32 | 648 × records | [`PatchRecord`]s, in primitive order |
 //! | … | 8 | [`checksum`] of the section before it |
 //!
+//! Then the scene section, the scene file's parse for `render --bvh` to skip the RON parse
+//! when the text is unchanged: the xxh3-64 of the scene file's bytes (`u64`, 0 for bare
+//! geometry), the length `u64` of the JSON that follows (`ron_format::SceneFile`), the
+//! JSON, and the [`checksum`] of the section.
+//!
 //! Records hold what the render reads of a patch: the `f32` net of the bicubic or bilinear
 //! fast path, its box, its (object, patch) number, and the `f64` control points and domain
 //! for normals and the `f64` and LG90 kernels. A scene with triangles, instances, patches
@@ -223,13 +228,14 @@ pub(super) fn records(patches: &OwnedPatches) -> Option<Vec<PatchRecord>> {
 }
 
 /// Writes the file: `bvh`'s tree section with `key`, then the patch section with `records`
-/// (or none) and the scene's `trim_loops`.
+/// (or none) and the scene's `trim_loops`, then the scene section with `parsed` (the
+/// scene's text hash and its parse as JSON, or nothing).
 pub(super) fn write(
     w: &mut dyn Write,
     bvh: &Bvh,
     key: u64,
-    records: Option<&[PatchRecord]>,
-    trim_loops: usize,
+    (records, trim_loops): (Option<&[PatchRecord]>, usize),
+    parsed: Option<(u64, &[u8])>,
 ) -> io::Result<()> {
     let tree = bvh.section(key);
     w.write_all(&tree)?;
@@ -249,6 +255,14 @@ pub(super) fn write(
     section.extend_from_slice(body);
     let sum = checksum(&section);
     w.write_all(&section)?;
+    w.write_all(&sum.to_le_bytes())?;
+    let (text_hash, json) = parsed.unwrap_or_default();
+    let mut scene = Vec::with_capacity(16 + json.len());
+    scene.extend_from_slice(&text_hash.to_le_bytes());
+    scene.extend_from_slice(&(json.len() as u64).to_le_bytes());
+    scene.extend_from_slice(json);
+    let sum = checksum(&scene);
+    w.write_all(&scene)?;
     w.write_all(&sum.to_le_bytes())
 }
 
@@ -298,12 +312,23 @@ pub struct BvhFile {
     pub trim_loops: usize,
 }
 
-/// Opens the BVH file at `path` for a scene with key `key` and `objects` objects, refusing
-/// a file of another version, built from other inputs, damaged (the byte offset of the
-/// fault), or whose records do not fit the scene. No file makes this or a later query
-/// panic or read out of bounds: every size, offset, alignment and index is checked before
-/// the bytes are cast.
-pub fn open(path: &Path, key: u64, objects: usize) -> Result<BvhFile, LoadError> {
+/// A mapped BVH file whose every section passed its structural and checksum checks, not
+/// yet checked against the scene ([`Opened::check`]).
+pub struct Opened {
+    map: Mmap,
+    bvh: Bvh,
+    key: u64,
+    /// First record and record count, when the file has records.
+    records: Option<(usize, usize)>,
+    trim_loops: usize,
+    /// The scene's parse: the hash of its text and the range of its JSON.
+    scene: (u64, std::ops::Range<usize>),
+}
+
+/// Maps the BVH file at `path` and checks its structure: no file makes this or a later
+/// query panic or read out of bounds, as every size, offset and alignment is checked
+/// before the bytes are cast; errors name the byte offset of the fault.
+pub fn map(path: &Path) -> Result<Opened, LoadError> {
     let invalid = |e: BvhFileError| LoadError::invalid(path, e.to_string());
     let file = File::open(path).map_err(|e| LoadError::io(path, e))?;
     // SAFETY: the mapping is read-only and private to this process; as for every reader of
@@ -311,7 +336,7 @@ pub fn open(path: &Path, key: u64, objects: usize) -> Result<BvhFile, LoadError>
     // while it is mapped is outside what we guard against. `patchtrace bvh` itself never
     // rewrites a file in place: it writes a temporary file and renames it.
     let map = unsafe { Mmap::map(&file) }.map_err(|e| LoadError::io(path, e))?;
-    let (bvh, tree_end) = Bvh::parse(&map, key).map_err(invalid)?;
+    let (bvh, key, tree_end) = Bvh::parse(&map).map_err(invalid)?;
     let at = tree_end.next_multiple_of(8);
     let truncated = |what| {
         invalid(BvhFileError::Truncated {
@@ -319,24 +344,22 @@ pub fn open(path: &Path, key: u64, objects: usize) -> Result<BvhFile, LoadError>
             at: map.len(),
         })
     };
-    if map.len() < at + SECTION_HEADER {
-        return Err(truncated("patch section header"));
-    }
-    let word = |k: usize| u64::from_le_bytes(super::bvh::field(&map, at + 8 * k));
-    let (has_records, count, trim_loops, record_size) = (word(0), word(1), word(2), word(3));
     let corrupt = |offset: usize, what: String| {
         invalid(BvhFileError::Corrupt(format!("byte {offset}: {what}")))
     };
+    if map.len() < at + SECTION_HEADER {
+        return Err(truncated("patch section header"));
+    }
+    let word = |offset: usize| u64::from_le_bytes(super::bvh::field(&map, offset));
+    let (has_records, count, trim_loops, record_size) =
+        (word(at), word(at + 8), word(at + 16), word(at + 24));
     if has_records > 1 {
         return Err(corrupt(at, format!("patch section flag {has_records}")));
     }
-    if record_size != size_of::<PatchRecord>() as u64 {
+    if record_size != RECORD_BYTES as u64 {
         return Err(corrupt(
             at + 24,
-            format!(
-                "patch records of {record_size} bytes, expected {}",
-                size_of::<PatchRecord>()
-            ),
+            format!("patch records of {record_size} bytes, expected {RECORD_BYTES}"),
         ));
     }
     let expected = if has_records == 1 {
@@ -354,50 +377,97 @@ pub fn open(path: &Path, key: u64, objects: usize) -> Result<BvhFile, LoadError>
         ));
     }
     let start = at + SECTION_HEADER;
-    let end = start + count as usize * size_of::<PatchRecord>();
+    let end = start + count as usize * RECORD_BYTES;
     if map.len() < end {
         return Err(truncated("patch records"));
     }
     if map.len() < end + 8 {
         return Err(truncated("patch section checksum"));
     }
-    if u64::from_le_bytes(super::bvh::field(&map, end)) != checksum(&map[at..end]) {
+    if word(end) != checksum(&map[at..end]) {
         return Err(corrupt(end, "patch section checksum mismatch".into()));
     }
-    if map.len() > end + 8 {
+    let scene = end + 8;
+    if map.len() < scene + 16 {
+        return Err(truncated("scene section header"));
+    }
+    let json_len = word(scene + 8);
+    if json_len > (map.len() - scene - 16) as u64 {
+        return Err(truncated("scene section"));
+    }
+    let json_end = scene + 16 + json_len as usize;
+    if map.len() < json_end + 8 {
+        return Err(truncated("scene section checksum"));
+    }
+    if word(json_end) != checksum(&map[scene..json_end]) {
+        return Err(corrupt(json_end, "scene section checksum mismatch".into()));
+    }
+    if map.len() > json_end + 8 {
         return Err(corrupt(
-            end + 8,
-            "extra bytes after the patch section".into(),
+            json_end + 8,
+            "extra bytes after the scene section".into(),
         ));
     }
-    let trim_loops = usize::try_from(trim_loops).unwrap_or(usize::MAX);
-    if has_records == 0 || cfg!(target_endian = "big") {
-        return Ok(BvhFile {
-            bvh,
-            patches: None,
-            trim_loops,
-        });
-    }
-    let records: &[PatchRecord] = bytemuck::try_cast_slice(&map[start..end]).map_err(|e| {
-        corrupt(
+    let records =
+        (has_records == 1 && cfg!(target_endian = "little")).then_some((start, count as usize));
+    if let Some((start, _)) = records
+        && bytemuck::try_cast_slice::<u8, PatchRecord>(&map[start..end]).is_err()
+    {
+        return Err(corrupt(
             start,
-            format!("patch records cannot be read in place ({e:?})"),
-        )
-    })?;
-    let fault = records
-        .par_iter()
-        .enumerate()
-        .find_map_first(|(i, r)| r.fault(objects).map(|f| (i, f)));
-    if let Some((i, f)) = fault {
-        return Err(corrupt(
-            start + i * size_of::<PatchRecord>(),
-            format!("patch record {i}: {f}"),
+            "patch records cannot be read in place".into(),
         ));
     }
-    let count = count as usize;
-    Ok(BvhFile {
+    Ok(Opened {
+        scene: (word(scene), scene + 16..json_end),
+        map,
         bvh,
-        patches: Some(MappedPatches { map, start, count }),
-        trim_loops,
+        key,
+        records,
+        trim_loops: usize::try_from(trim_loops).unwrap_or(usize::MAX),
     })
+}
+
+impl Opened {
+    /// The scene's parse the file keeps: the xxh3-64 of the scene file's bytes and the
+    /// JSON of its serde mirror (`scene::ron_format::ParsedScene`), empty when none.
+    pub fn cached_scene(&self) -> (u64, &[u8]) {
+        (self.scene.0, &self.map[self.scene.1.clone()])
+    }
+
+    /// Accepts the file for a scene with input key `key` and `objects` objects: refused
+    /// when built from other inputs, or when a record names an object the scene lacks or
+    /// has degrees or a net kind no record can have (the byte offset of the record).
+    pub fn check(self, path: &Path, key: u64, objects: usize) -> Result<BvhFile, LoadError> {
+        let invalid = |e: BvhFileError| LoadError::invalid(path, e.to_string());
+        super::bvh::check_key(self.key, key).map_err(invalid)?;
+        let Some((start, count)) = self.records else {
+            return Ok(BvhFile {
+                bvh: self.bvh,
+                patches: None,
+                trim_loops: self.trim_loops,
+            });
+        };
+        let patches = MappedPatches {
+            map: self.map,
+            start,
+            count,
+        };
+        let fault = patches
+            .records()
+            .par_iter()
+            .enumerate()
+            .find_map_first(|(i, r)| r.fault(objects).map(|f| (i, f)));
+        if let Some((i, f)) = fault {
+            let at = start + i * RECORD_BYTES;
+            return Err(invalid(BvhFileError::Corrupt(format!(
+                "byte {at}: patch record {i}: {f}"
+            ))));
+        }
+        Ok(BvhFile {
+            bvh: self.bvh,
+            patches: Some(patches),
+            trim_loops: self.trim_loops,
+        })
+    }
 }

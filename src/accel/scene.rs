@@ -1001,17 +1001,9 @@ pub enum FromFile {
 }
 
 impl SceneGeometry {
-    /// Opens the BVH file at `path` for a scene whose inputs have key `key` (its
-    /// [`SourceKey`](crate::scene::source_key::SourceKey) digest) and which has `objects`
-    /// objects, refusing a file built from other inputs, of another version, or damaged,
-    /// with a message that says what to do.
-    pub fn open(
-        path: &std::path::Path,
-        key: u64,
-        objects: usize,
-    ) -> Result<FromFile, crate::scene::LoadError> {
-        let file = mapped::open(path, key, objects)?;
-        Ok(match file.patches {
+    /// The geometry of a BVH file accepted for the scene ([`mapped::Opened::check`]).
+    pub fn from_file(file: mapped::BvhFile) -> FromFile {
+        match file.patches {
             Some(patches) => {
                 let accel = Accel::bvh(file.bvh, patches.len(), &Triangles::default());
                 let geometry = SceneGeometry {
@@ -1024,7 +1016,7 @@ impl SceneGeometry {
                 FromFile::Mapped(Box::new(geometry), file.trim_loops)
             }
             None => FromFile::TreeOnly(file.bvh),
-        })
+        }
     }
 
     /// Prepares `scene` with a tree from its BVH file ([`FromFile::TreeOnly`]); `path`
@@ -1053,12 +1045,14 @@ impl SceneGeometry {
 
     /// Writes the BVH file for inputs with key `key`, atomically: the tree, and the
     /// prepared patches when the geometry is only patches the file can hold, with the
-    /// scene's `trim_loops`; whether it holds the patches. Refused for a grid.
+    /// scene's `trim_loops`, and the scene file's `parsed` form (`ron_format::parsed_scene`)
+    /// when there is one; whether it holds the patches. Refused for a grid.
     pub fn save_bvh(
         &self,
         path: &std::path::Path,
         key: u64,
         trim_loops: usize,
+        parsed: Option<(u64, &[u8])>,
     ) -> Result<bool, crate::scene::LoadError> {
         let Accel::Bvh(bvh, _) = &self.accel else {
             return Err(crate::scene::LoadError::invalid(
@@ -1075,7 +1069,7 @@ impl SceneGeometry {
             _ => None,
         };
         crate::scene::write::write_atomic(path, |w| {
-            mapped::write(w, bvh, key, records.as_deref(), trim_loops)
+            mapped::write(w, bvh, key, (records.as_deref(), trim_loops), parsed)
         })?;
         Ok(records.is_some())
     }

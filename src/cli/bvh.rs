@@ -8,14 +8,21 @@ use crate::cli::args::BvhArgs;
 use crate::cli::setup::{build_bvh, load_keyed};
 
 pub fn run(args: BvhArgs) -> anyhow::Result<ExitCode> {
-    let (scene, source) = load_keyed(&args.scene, &args.mesh, args.quiet, false)?;
+    let (scene, source) = load_keyed(&args.scene, &args.mesh, args.quiet, (false, None))?;
     // What "built in" covers: collecting the patches (NURBS to Bézier, trims), their boxes,
     // the tree and its wide form, and preparing the patches for the kernel.
     let start = Instant::now();
     let geometry = build_bvh(&scene, args.quiet);
     let build = start.elapsed().as_secs_f64();
     let key = crate::accel::mapped::key(source, false);
-    let with_patches = geometry.save_bvh(&args.output, key, scene.trim_loop_count())?;
+    let parsed = match crate::scene::load::InputKind::of(&args.scene) {
+        Some(crate::scene::load::InputKind::Ron) => {
+            crate::scene::ron_format::parsed_scene(&args.scene)
+        }
+        _ => None,
+    };
+    let parsed = parsed.as_ref().map(|(hash, json)| (*hash, json.as_slice()));
+    let with_patches = geometry.save_bvh(&args.output, key, scene.trim_loop_count(), parsed)?;
     eprintln!(
         "wrote {}: {} patches, {} nodes, built in {:.3} s{}",
         args.output.display(),

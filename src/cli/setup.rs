@@ -115,7 +115,7 @@ pub fn prepare(
     if let (AccelChoice::Bvh, Some(path)) = (args.accel, &args.bvh) {
         return prepare_from_file(scene_path, mesh, args, path, quiet);
     }
-    let (mut scene, source_key) = load_keyed(scene_path, mesh, quiet, false)?;
+    let (mut scene, source_key) = load_keyed(scene_path, mesh, quiet, (false, None))?;
     let trims = TrimEffect::of(&scene, args.ignore_trims);
     if args.ignore_trims {
         scene = scene.without_trims();
@@ -147,15 +147,16 @@ pub fn load_keyed(
     path: &Path,
     mesh: &MeshArgs,
     quiet: bool,
-    defer: bool,
+    (defer, parsed): (bool, Option<(u64, &[u8])>),
 ) -> Result<(Scene, u64), crate::scene::LoadError> {
     crate::progress::while_reading(quiet, path, || {
-        load_scene_keyed(path, mesh.load_options(), defer)
+        load_scene_keyed(path, mesh.load_options(), defer, parsed)
     })
 }
 
-/// [`prepare`] with `--bvh FILE`: the scene is read without its geometry files and the
-/// file's prepared patches are mapped; only a file that holds the tree alone (the scene
+/// [`prepare`] with `--bvh FILE`: the file is mapped, the scene read without its geometry
+/// files (and from the parse the file keeps when the scene's text is unchanged), and the
+/// file's prepared patches used in place; only a file that holds the tree alone (the scene
 /// has geometry its records cannot hold) makes the scene be read again, with its geometry.
 fn prepare_from_file(
     scene_path: &Path,
@@ -165,11 +166,14 @@ fn prepare_from_file(
     quiet: bool,
 ) -> anyhow::Result<Prepared> {
     let start = Instant::now();
-    let (scene, source) = load_keyed(scene_path, mesh, quiet, true)?;
+    let opened = crate::accel::mapped::map(bvh_path)?;
+    let parsed = Some(opened.cached_scene());
+    let (scene, source) = load_keyed(scene_path, mesh, quiet, (true, parsed))?;
     let load_seconds = start.elapsed().as_secs_f64();
     let start = Instant::now();
     let key = crate::accel::mapped::key(source, args.ignore_trims);
-    let (scene, geometry, trims) = match SceneGeometry::open(bvh_path, key, scene.objects.len())? {
+    let file = opened.check(bvh_path, key, scene.objects.len())?;
+    let (scene, geometry, trims) = match SceneGeometry::from_file(file) {
         FromFile::Mapped(geometry, loops) => {
             let trims = TrimEffect {
                 loops,

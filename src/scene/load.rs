@@ -160,14 +160,16 @@ pub fn load_scene_with(path: &Path, options: LoadOptions) -> Result<Scene, LoadE
 /// the key its BVH file is checked against. With `defer`, a RON scene's geometry files are
 /// hashed but not parsed, and the objects they feed get no geometry: for a caller that
 /// finds it prepared in a BVH file with this key. Bare geometry is always read (its default
-/// camera frames it) and keyed by its bytes and `options`.
+/// camera frames it) and keyed by its bytes and `options`. `parsed` is a RON scene's
+/// [`ron_format::parsed_scene`] kept in a BVH file.
 pub fn load_scene_keyed(
     path: &Path,
     options: LoadOptions,
     defer: bool,
+    parsed: Option<(u64, &[u8])>,
 ) -> Result<(Scene, u64), LoadError> {
     if InputKind::of(path) == Some(InputKind::Ron) && !options.subdivide {
-        let (scene, key) = ron_format::read_scene_keyed(path, defer)?;
+        let (scene, key) = ron_format::read_scene_keyed(path, defer, parsed)?;
         check_f32_range(path, &scene)?;
         check_trims(path, &scene)?;
         return Ok((scene, key));

@@ -107,18 +107,20 @@ impl Bvh {
     pub fn read(r: &mut dyn Read, expected_key: u64) -> Result<Bvh, BvhFileError> {
         let mut bytes = Vec::new();
         r.read_to_end(&mut bytes)?;
-        let (bvh, end) = Bvh::parse(&bytes, expected_key)?;
+        let (bvh, key, end) = Bvh::parse(&bytes)?;
         if end != bytes.len() {
             return Err(BvhFileError::Corrupt(format!(
                 "byte {end}: extra bytes after the checksum"
             )));
         }
+        check_key(key, expected_key)?;
         Ok(bvh)
     }
 
     /// Parses the tree section at the start of `bytes`, with the checks of
-    /// [`read`](Bvh::read), returning the tree and the offset where the section ends.
-    pub(crate) fn parse(bytes: &[u8], expected_key: u64) -> Result<(Bvh, usize), BvhFileError> {
+    /// [`read`](Bvh::read) but the key's ([`check_key`]), returning the tree, the key it
+    /// records and the offset where the section ends.
+    pub(crate) fn parse(bytes: &[u8]) -> Result<(Bvh, u64, usize), BvhFileError> {
         let magic_len = bytes.len().min(MAGIC.len());
         if magic_len == 0 || bytes[..magic_len] != MAGIC[..magic_len] {
             return Err(BvhFileError::NotBvh);
@@ -161,16 +163,23 @@ impl Bvh {
                 "byte {data_end}: checksum mismatch"
             )));
         }
-        if found_key != expected_key {
-            return Err(BvhFileError::Stale {
-                found: found_key,
-                expected: expected_key,
-            });
-        }
         let nodes_end = HEADER_LEN + size_of::<Node>() * node_count;
         let nodes = words(&bytes[HEADER_LEN..nodes_end]);
         let prim_indices = words(&bytes[nodes_end..data_end]);
-        Ok((Bvh::from_parts(nodes, prim_indices)?, data_end + 8))
+        Ok((
+            Bvh::from_parts(nodes, prim_indices)?,
+            found_key,
+            data_end + 8,
+        ))
+    }
+}
+
+/// Refuses a file whose recorded input key `found` is not the scene's `expected` one.
+pub(crate) fn check_key(found: u64, expected: u64) -> Result<(), BvhFileError> {
+    if found == expected {
+        Ok(())
+    } else {
+        Err(BvhFileError::Stale { found, expected })
     }
 }
 

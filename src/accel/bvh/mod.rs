@@ -20,8 +20,8 @@ mod file;
 mod traverse;
 mod wide;
 
-pub(crate) use file::field;
 pub use file::{BvhFileError, FORMAT_VERSION, MAGIC, checksum};
+pub(crate) use file::{check_key, field};
 pub use traverse::TraversalStats;
 
 use crate::geom::Aabb;
