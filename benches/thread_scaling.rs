@@ -22,7 +22,7 @@ use support::median;
 
 /// Items of the ceiling loop, and the arithmetic per item: about one second on one core.
 const ITEMS: u64 = 4096;
-const STEPS_PER_ITEM: u32 = 200_000;
+const STEPS_PER_ITEM: u32 = 40_000;
 
 /// One item of the ceiling loop: a chain of dependent multiply-adds and square roots that
 /// the compiler cannot fold, kept in registers.
