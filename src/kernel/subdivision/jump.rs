@@ -364,21 +364,30 @@ mod tests {
     /// the jump leaves the cell to it; farther out than the floor the cell is dropped.
     #[test]
     fn a_near_miss_within_the_end_game_floor_is_left_to_the_halving_search() {
-        // F(u, v) = (u + 2e-5, v - 0.5): the crossing is at u = -2e-5, beyond the rounding
-        // allowance (32 ulps of the net's magnitude 1, 3.8e-6).
-        let lin = linearize(&linear_net([[1.0, 0.0], [0.0, 1.0]], [2e-5, -0.5]));
+        // Distances in units of the rounding allowance η (ROUNDING_ULPS ulps of the net's
+        // magnitude, 1 here), so the cases sit where the plan's arithmetic puts them.
+        let eta = ROUNDING_ULPS as f32 * f32::EPSILON;
+        let net = |offset: f32| linearize(&linear_net([[1.0, 0.0], [0.0, 1.0]], [offset, -0.5]));
+        // F(u, v) = (u + 5η, v - 0.5): the crossing is at u = -5η, beyond the u = 0 edge.
+        let beyond = net(5.0 * eta);
         let border = [[true, false], [false, false]];
-        assert_eq!(plan(&lin, [20, 20], 4e-5, border), JumpOutcome::Undecided);
-        assert_eq!(plan(&lin, [20, 20], 1e-5, border), JumpOutcome::Empty);
-        assert_eq!(plan(&lin, [20, 20], 0.0, border), JumpOutcome::Empty);
-        // A crossing just inside lands, but a miss of its sub-cell's box may not drop the
+        assert_eq!(
+            plan(&beyond, [20, 20], 10.0 * eta, border),
+            JumpOutcome::Undecided
+        );
+        assert_eq!(
+            plan(&beyond, [20, 20], 2.0 * eta, border),
+            JumpOutcome::Empty
+        );
+        assert_eq!(plan(&beyond, [20, 20], 0.0, border), JumpOutcome::Empty);
+        // A crossing 3η inside lands, but a miss of its sub-cell's box may not drop the
         // cell: the window of near points reaches beyond the border.
-        let inside = linearize(&linear_net([[1.0, 0.0], [0.0, 1.0]], [-1e-5, -0.5]));
-        let JumpOutcome::Landed(jump) = plan(&inside, [20, 20], 4e-5, border) else {
+        let inside = net(-3.0 * eta);
+        let JumpOutcome::Landed(jump) = plan(&inside, [20, 20], 10.0 * eta, border) else {
             panic!("the crossing is inside the cell");
         };
         assert!(!jump.holds_near);
-        let JumpOutcome::Landed(jump) = plan(&inside, [20, 20], 4e-5, [[false; 2]; 2]) else {
+        let JumpOutcome::Landed(jump) = plan(&inside, [20, 20], 10.0 * eta, [[false; 2]; 2]) else {
             panic!("the crossing is inside the cell");
         };
         assert!(jump.holds_near);
