@@ -95,3 +95,66 @@ fn empty_tree_visits_nothing() {
     assert_eq!(stats.nodes_visited, 0);
     assert!(!bvh.traverse_any(&ray, |_| true).0);
 }
+
+/// A cull margin grows every box by that much on each side, and by nothing else: rays
+/// running in the plane of a flat box (a patch lying in a coordinate plane), with a
+/// direction component of 0, -0 or ±1e-18 across it, enter the box when they pass within
+/// the margin and not when they pass twice as far; with no margin, one ulp off the plane
+/// is a miss.
+#[test]
+fn cull_margin_grows_boxes_by_the_margin() {
+    use glam::Vec3;
+    use patchtrace::geom::{Aabb, Ray};
+    use std::ops::ControlFlow;
+    // Several boxes, so that the flat one sits below a wide inner node.
+    let flat = Aabb {
+        min: Vec3::new(0.0, 0.0, 0.5),
+        max: Vec3::new(1.0, 1.0, 0.5),
+    };
+    let others: Vec<Aabb> = (1..6)
+        .map(|k| Aabb {
+            min: Vec3::new(3.0 * k as f32, 0.0, 0.0),
+            max: Vec3::new(3.0 * k as f32 + 1.0, 1.0, 1.0),
+        })
+        .collect();
+    let boxes: Vec<Aabb> = std::iter::once(flat).chain(others).collect();
+    let bvh = Bvh::build(&boxes);
+    let enters_flat = |ray: &Ray, margin: f32| {
+        let mut seen = false;
+        bvh.traverse_leaves(ray, margin, |range, _| {
+            seen |= bvh.prim_indices()[range].contains(&0);
+            ControlFlow::Continue(())
+        });
+        seen
+    };
+    let margin = 1e-5;
+    for across in [0.0, -0.0, 1e-18, -1e-18] {
+        let ray_at = |z: f32| Ray {
+            origin: Vec3::new(-1.0, 0.2, z),
+            dir: Vec3::new(1.0, 0.3, across),
+            tmin: 0.0,
+            tmax: f32::INFINITY,
+        };
+        for side in [1.0f32, -1.0] {
+            let z = |offset: f32| 0.5 + side * offset;
+            assert!(enters_flat(&ray_at(z(0.5 * margin)), margin), "{across} {side}");
+            assert!(!enters_flat(&ray_at(z(2.0 * margin)), margin), "{across} {side}");
+            let one_ulp = if side > 0.0 {
+                0.5f32.next_up()
+            } else {
+                0.5f32.next_down()
+            };
+            assert!(!enters_flat(&ray_at(one_ulp), 0.0), "{across} {side}");
+            assert!(enters_flat(&ray_at(one_ulp), margin), "{across} {side}");
+        }
+        // Beside the box rather than above it: the margin applies on every axis.
+        let beside = Ray {
+            origin: Vec3::new(-1.0, 1.0 + 0.5 * margin, 0.5),
+            dir: Vec3::new(1.0, across, 0.0),
+            tmin: 0.0,
+            tmax: f32::INFINITY,
+        };
+        assert!(enters_flat(&beside, margin), "{across}");
+        assert!(!enters_flat(&beside, 0.0), "{across}");
+    }
+}

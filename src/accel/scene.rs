@@ -473,6 +473,19 @@ impl SceneGeometry {
         }
     }
 
+    /// The margin the BVH grows its boxes by for `ray`: patches are searched in the ray's
+    /// own space and may be hit a little outside their exact box
+    /// ([`subdivision::cull_margin`]), as may instances, whose geometry takes the ray mapped
+    /// into object space; triangles alone are tested exactly against exact boxes.
+    fn cull_margin(&self, bvh: &Bvh, ray: &Ray) -> f32 {
+        if self.patches.len() == 0 && self.instances.is_empty() {
+            return 0.0;
+        }
+        let b = bvh.bounds();
+        let reach = b.min.abs().max(b.max.abs()).max_element();
+        subdivision::cull_margin(ray.origin.to_array(), reach)
+    }
+
     /// The nearest hit along `ray` in `[ray.tmin, ray.tmax]`.
     pub fn intersect(
         &self,
@@ -647,7 +660,8 @@ impl SceneGeometry {
         let mut surface_tests = 0;
         // Instances' work, counted apart from `kernel`, which the closure holds.
         let mut nested = QueryStats::default();
-        let t = bvh.traverse_leaves(ray, |range, tmax| {
+        let margin = self.cull_margin(bvh, ray);
+        let t = bvh.traverse_leaves(ray, margin, |range, tmax| {
             surface_tests += range.len() as u64;
             if patches > 0 || !self.instances.is_empty() {
                 for &prim in &bvh.prim_indices()[range.clone()] {
@@ -727,7 +741,8 @@ impl SceneGeometry {
         let mut patch_ray = PatchRay::new(ray);
         let mut hit = false;
         let mut surface_tests = 0;
-        let t = bvh.traverse_leaves(ray, |range, _| {
+        let margin = self.cull_margin(bvh, ray);
+        let t = bvh.traverse_leaves(ray, margin, |range, _| {
             surface_tests += range.len() as u64;
             hit = bvh.prim_indices()[range.clone()].iter().any(|&prim| {
                 if prim >= first_instance {

@@ -23,23 +23,32 @@ pub struct TraversalStats {
     pub box_tests: u64,
 }
 
-/// The ray in the form the 4-wide slab test wants: origin and reciprocal direction splat per
-/// axis, and per axis the index in [`WideNode::planes`](super::wide::WideNode) of the box
-/// plane the ray meets first (`near`) and last (`far`).
+/// The ray in the form the 4-wide slab test wants: reciprocal direction splat per axis, per
+/// axis the index in [`WideNode::planes`](super::wide::WideNode) of the box plane the ray
+/// meets first (`near`) and last (`far`), and the origin as each of those planes sees it.
+///
+/// A cull margin `m` grows every box by `m` on each side: the near plane moves back by `m`
+/// and the far plane forward, which is the plane unmoved against an origin moved the other
+/// way (`min - m - o = min - (o + m)` going up an axis). So the margin costs nothing per box
+/// test: `origin_near` is `o + m` going up an axis and `o - m` going down, `origin_far` the
+/// reverse.
 struct WideRay {
-    origin: [Vec4; 3],
+    origin_near: [Vec4; 3],
+    origin_far: [Vec4; 3],
     inv_dir: [Vec4; 3],
     near: [usize; 3],
     far: [usize; 3],
 }
 
 impl WideRay {
-    fn new(ray: &Ray) -> WideRay {
+    fn new(ray: &Ray, margin: f32) -> WideRay {
         let inv = ray.dir.recip();
         // 1 / -0 is -inf: a ray with a -0 component counts as going down that axis.
         let negative = [0, 1, 2].map(|k| usize::from(inv[k] < 0.0));
+        let toward_near = [0, 1, 2].map(|k| if negative[k] == 1 { -margin } else { margin });
         WideRay {
-            origin: [0, 1, 2].map(|k| Vec4::splat(ray.origin[k])),
+            origin_near: [0, 1, 2].map(|k| Vec4::splat(ray.origin[k] + toward_near[k])),
+            origin_far: [0, 1, 2].map(|k| Vec4::splat(ray.origin[k] - toward_near[k])),
             inv_dir: [0, 1, 2].map(|k| Vec4::splat(inv[k])),
             near: [0, 1, 2].map(|k| k + 3 * negative[k]),
             far: [0, 1, 2].map(|k| k + 3 * (1 - negative[k])),
@@ -55,11 +64,10 @@ impl WideRay {
     /// either way), so each chain starts from the slab values and ends in a number.
     #[inline(always)]
     fn slab4(&self, planes: &[Vec4; 6], tmin: f32, tmax: f32) -> (Vec4, Vec4) {
-        let t = |k: usize, plane: usize| (planes[plane] - self.origin[k]) * self.inv_dir[k];
-        let enter = t(0, self.near[0])
-            .max(t(1, self.near[1]).max(t(2, self.near[2]).max(Vec4::splat(tmin))));
-        let exit = t(0, self.far[0])
-            .min(t(1, self.far[1]).min(t(2, self.far[2]).min(Vec4::splat(f32::INFINITY))));
+        let t_near = |k: usize| (planes[self.near[k]] - self.origin_near[k]) * self.inv_dir[k];
+        let t_far = |k: usize| (planes[self.far[k]] - self.origin_far[k]) * self.inv_dir[k];
+        let enter = t_near(0).max(t_near(1).max(t_near(2).max(Vec4::splat(tmin))));
+        let exit = t_far(0).min(t_far(1).min(t_far(2).min(Vec4::splat(f32::INFINITY))));
         (enter, (exit * SLAB_FAR_SCALE).min(Vec4::splat(tmax)))
     }
 }
@@ -74,7 +82,7 @@ impl Bvh {
         ray: &Ray,
         mut hit: F,
     ) -> TraversalStats {
-        self.traverse_leaves(ray, |range, tmax| {
+        self.traverse_leaves(ray, 0.0, |range, tmax| {
             for &prim in &self.prim_indices[range] {
                 if let Some(t) = hit(prim, *tmax) {
                     *tmax = tmax.min(t);
@@ -92,7 +100,7 @@ impl Bvh {
         mut hit: F,
     ) -> (bool, TraversalStats) {
         let mut found = false;
-        let stats = self.traverse_leaves(ray, |range, _| {
+        let stats = self.traverse_leaves(ray, 0.0, |range, _| {
             if self.prim_indices[range].iter().any(|&p| hit(p)) {
                 found = true;
                 ControlFlow::Break(())
@@ -106,9 +114,12 @@ impl Bvh {
     /// The walk itself, a leaf at a time: `visit(range, &mut tmax)` gets the leaf's range of
     /// [`prim_indices`](Bvh::prim_indices) (leaves own disjoint ranges, so callers can keep
     /// per-leaf data in that order) and may shorten the ray or stop the walk. Leaves are
-    /// offered nearest entry first, and only while their entry is within `tmax`.
+    /// offered nearest entry first, and only while their entry is within `tmax`. Every box
+    /// is grown by `margin` on each side (0 for the exact boxes): the leaves of primitives
+    /// whose kernel may find a hit a little outside their box need it (patches in ray
+    /// space, [`crate::kernel::subdivision::cull_margin`]).
     #[inline(always)]
-    pub fn traverse_leaves<F>(&self, ray: &Ray, mut visit: F) -> TraversalStats
+    pub fn traverse_leaves<F>(&self, ray: &Ray, margin: f32, mut visit: F) -> TraversalStats
     where
         F: FnMut(std::ops::Range<usize>, &mut f32) -> ControlFlow<()>,
     {
@@ -124,7 +135,7 @@ impl Bvh {
         if self.wide.is_empty() || !(ray.origin.is_finite() && ray.dir.is_finite()) {
             return stats;
         }
-        let wray = WideRay::new(ray);
+        let wray = WideRay::new(ray, margin);
         let tmin = ray.tmin;
         let mut tmax = ray.tmax;
         // Each wide level pushes at most WIDTH - 1 entries, and what is on the stack was

@@ -42,6 +42,7 @@ pub use config::{
     SubdivisionConfig, Termination,
 };
 pub use prepared::PreparedPatch;
+pub use ray_space::cull_margin;
 pub use reference::{PatchHit64, intersect_f64};
 
 use bicubic::Net;

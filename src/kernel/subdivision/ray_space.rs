@@ -67,6 +67,35 @@ use crate::geom::DAabb;
 /// nets, `super::NET_ROUNDING_ULPS`). 8 leaves room above 3.5 + 2.
 pub const TRANSFORM_ULPS: f64 = 8.0;
 
+/// How far, in `f32` ulps of a bound on the ray's distance to the geometry, a patch that
+/// the ray hits in its ray space can lie outside the ray in world space: the accelerator
+/// must not cull boxes nearer the ray than this ([`cull_margin`]).
+///
+/// Why: crack freedom holds in ray space (neighbours' transformed edges are bit-identical),
+/// but a ray that passes a shared edge within the transform's rounding may be inside the
+/// ray-space net of patch A and outside A's exact world box, while neighbour B's ray-space
+/// net lets it through on A's side. Culling A by its world box then loses the hit, or
+/// hands the ray to a surface behind (measured: 1 ray in 30,000 aimed at the shared
+/// edges of a subdivision-surface bipyramid, and rays lying in a flat patch's plane with a
+/// direction component of ±1e-18). A ray-space coordinate is within [`TRANSFORM_ULPS`]
+/// ulps of its exact value at the ray-space scale `|p - o| / |d|`, which is at most two
+/// ulps of `|p - o|` back in world units, on each of the two axes across the ray: within
+/// `2 √2 TRANSFORM_ULPS` ulps (about 22.6) of `|p - o|` of the ray. 32 also covers the
+/// rounding of the margin's own arithmetic.
+pub const CULL_MARGIN_ULPS: f32 = 32.0;
+
+/// The margin by which an accelerator grows the boxes of patches for `ray` (see
+/// [`CULL_MARGIN_ULPS`]), for geometry whose coordinates are at most `reach` in magnitude:
+/// `|p - o| <= √3 (max |o| + reach)`, bounded by twice that sum. A few ulps of the scene's
+/// scale, so it admits only boxes the ray passes within rounding of.
+pub fn cull_margin(origin: [f32; 3], reach: f32) -> f32 {
+    let o = origin.iter().fold(0f32, |m, c| m.max(c.abs()));
+    let distance = 2.0 * (o + reach);
+    let m = CULL_MARGIN_ULPS as f64 * crate::geom::ulp::ulp_of(distance);
+    // An infinite reach or origin has no finite margin; traversal refuses such rays.
+    if m.is_finite() { m as f32 } else { 0.0 }
+}
+
 /// Smallest ray-space coordinate scale (the largest magnitude of the patch's ray-space
 /// box) searched in ray space: 2^-39, so that an edge of one ulp of that scale (2^-63)
 /// still has a normal square (2^-126 = `f32::MIN_POSITIVE`) for the length heuristic.
