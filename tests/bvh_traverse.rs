@@ -137,8 +137,14 @@ fn cull_margin_grows_boxes_by_the_margin() {
         };
         for side in [1.0f32, -1.0] {
             let z = |offset: f32| 0.5 + side * offset;
-            assert!(enters_flat(&ray_at(z(0.5 * margin)), margin), "{across} {side}");
-            assert!(!enters_flat(&ray_at(z(2.0 * margin)), margin), "{across} {side}");
+            assert!(
+                enters_flat(&ray_at(z(0.5 * margin)), margin),
+                "{across} {side}"
+            );
+            assert!(
+                !enters_flat(&ray_at(z(2.0 * margin)), margin),
+                "{across} {side}"
+            );
             let one_ulp = if side > 0.0 {
                 0.5f32.next_up()
             } else {
