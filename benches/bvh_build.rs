@@ -71,6 +71,7 @@ fn main() {
                 key,
                 scene.trim_loop_count(),
                 Some((parsed.0, &parsed.1)),
+                &|_, _| None,
             )
             .expect("file written");
         assert!(

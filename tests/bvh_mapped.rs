@@ -2,7 +2,8 @@
 //! `render --bvh`, renders the bytes a fresh build renders; it is refused as stale when an
 //! input file's bytes or a transform change (and not when only a material does), refused
 //! with a byte offset when truncated or damaged, never with a panic; and the parallel
-//! build gives a valid tree, the same for one thread as for two.
+//! build gives a valid tree, the same for one thread as for two. `trace --bvh` reports
+//! what `trace` reports, a subdivision surface's quads included.
 
 mod bvh_support;
 mod common;
@@ -10,7 +11,7 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use bvh_support::{Rng, random_boxes};
-use common::{render, run, stderr, testdata};
+use common::{render, run, stderr, testdata, trace_rows};
 use glam::Vec3;
 use patchtrace::accel::bvh::{Bvh, checksum};
 use patchtrace::accel::mapped;
@@ -342,4 +343,80 @@ fn the_parallel_build_is_valid_and_the_same_on_one_thread_and_two() {
     assert_valid(&two, &boxes);
     assert_eq!(one.nodes(), two.nodes());
     assert_eq!(one.prim_indices(), two.prim_indices());
+}
+
+/// A subdivision surface's patches come from the file, but `trace` reports the quad after
+/// the first Catmull–Clark step and (u, v) in it (DESIGN.md via README): the file keeps
+/// where each patch lies, so `trace --bvh` prints the rows `trace` prints, and every
+/// reported patch of the cube is one of its 24 quads (its 1320 patches are not).
+#[test]
+fn trace_with_the_file_reports_the_quads_of_a_subdivision_surface() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        testdata("opensubdiv/catmark_cube.obj"),
+        dir.path().join("cube.obj"),
+    )
+    .unwrap();
+    std::fs::copy(testdata("teapot.bpt"), dir.path().join("teapot.bpt")).unwrap();
+    let scene = dir.path().join("cage.ron");
+    std::fs::write(
+        &scene,
+        r#"Scene(
+    camera: (eye: (0, -9, 3), look_at: (0, 0, 0), up: (0, 0, 1), fov_y: 40, width: 32, height: 32),
+    lights: [Point(position: (6, -6, 10), intensity: (1, 1, 1))],
+    materials: { "grey": (diffuse: (0.7, 0.7, 0.7)) },
+    objects: [
+        (geometry: Subdivision(File("cube.obj")), material: "grey"),
+        (geometry: File("teapot.bpt"), material: "grey", transform: [Translate(4, 0, 0)]),
+    ],
+)"#,
+    )
+    .unwrap();
+    let bvh = dir.path().join("cage.bvh");
+    assert!(build(&scene, &bvh).contains("with the prepared patches"));
+    // Rays from a sphere of radius 6 around the cube towards points near its centre.
+    let mut rng = Rng::new(77);
+    let mut rays = String::new();
+    for _ in 0..2000 {
+        let d = loop {
+            let v = Vec3::new(
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+            );
+            if (0.1..1.0).contains(&v.length_squared()) {
+                break v.normalize();
+            }
+        };
+        let aim = Vec3::new(
+            rng.range(-0.6, 0.6),
+            rng.range(-0.6, 0.6),
+            rng.range(-0.6, 0.6),
+        );
+        let o = d * 6.0;
+        let dir = aim - o;
+        rays.push_str(&format!(
+            "{} {} {} {} {} {}\n",
+            o.x, o.y, o.z, dir.x, dir.y, dir.z
+        ));
+    }
+    let fresh = trace_rows(&scene, &rays, &[]);
+    let mapped = trace_rows(&scene, &rays, &["--bvh", bvh.to_str().unwrap()]);
+    assert_eq!(fresh, mapped);
+    let cube_hits: Vec<u32> = fresh
+        .iter()
+        .filter(|r| r[1] == "1" && r[3] == "0")
+        .map(|r| r[4].parse().unwrap())
+        .collect();
+    assert!(cube_hits.len() > 1500, "{} hits", cube_hits.len());
+    assert!(cube_hits.iter().all(|&q| q < 24), "{cube_hits:?}");
+    // Pieces beyond the whole quads were reported through the file: some hit patches lie
+    // near the extraordinary vertices, inside a quad's corner.
+    let near_corner = fresh.iter().filter(|r| {
+        r[1] == "1" && r[3] == "0" && {
+            let (u, v): (f64, f64) = (r[5].parse().unwrap(), r[6].parse().unwrap());
+            u.min(1.0 - u).max(v.min(1.0 - v)) < 0.05
+        }
+    });
+    assert!(near_corner.count() > 0);
 }

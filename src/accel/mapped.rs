@@ -11,8 +11,8 @@
 //! | 0 | 8 | 1 if the records follow, 0 if the scene has geometry they cannot hold |
 //! | 8 | 8 | record count `u64` (the tree's primitive count when there are records) |
 //! | 16 | 8 | trim loops in the scene `u64` (for the effect line; none cuts a mapped patch) |
-//! | 24 | 8 | record size `u64` ([`PatchRecord`], 648) |
-//! | 32 | 648 × records | [`PatchRecord`]s, in primitive order |
+//! | 24 | 8 | record size `u64` ([`PatchRecord`], 680) |
+//! | 32 | 680 × records | [`PatchRecord`]s, in primitive order |
 //! | … | 8 | [`checksum`] of the section before it |
 //!
 //! Then the scene section, the scene file's parse for `render --bvh` to skip the RON parse
@@ -22,7 +22,9 @@
 //!
 //! Records hold what the render reads of a patch: the `f32` net of the bicubic or bilinear
 //! fast path, its box, its (object, patch) number, and the `f64` control points and domain
-//! for normals and the `f64` and LG90 kernels. A scene with triangles, instances, patches
+//! for normals and the `f64` and LG90 kernels, and for a patch of a Catmull–Clark surface
+//! where it lies in its quad after the first step (its [`Piece`], which `trace` reports,
+//! format version 3). A scene with triangles, instances, patches
 //! its trim loops cut, or patches of the general (rational or other-degree) path has no
 //! records; its file holds the tree only, and the geometry is built from the scene.
 
@@ -37,6 +39,7 @@ use rayon::prelude::*;
 use super::bvh::{Bvh, BvhFileError, checksum};
 use super::patches::OwnedPatches;
 use crate::geom::bezier::ParamRect;
+use crate::geom::subdiv::Piece;
 use crate::geom::{Aabb, BezierPatch};
 use crate::kernel::subdivision::PreparedPatch;
 use crate::kernel::subdivision::bicubic::Net;
@@ -70,6 +73,9 @@ const KIND_BILINEAR: u32 = 2;
 
 const SECTION_HEADER: usize = 32;
 
+/// `piece_face` of a patch that is not part of a subdivision surface.
+const NO_PIECE: u32 = u32::MAX;
+
 /// Bytes per patch record in the file.
 pub const RECORD_BYTES: usize = size_of::<PatchRecord>();
 
@@ -87,10 +93,15 @@ pub(super) struct PatchRecord {
     patch: u32,
     /// Degree in u in the low 16 bits, in v in the high 16.
     degrees: u32,
+    /// For a patch of a subdivision surface its [`Piece`]: the quad, the quarter turns,
+    /// and (in `piece`) the origin u, v and size; `piece_face` is [`NO_PIECE`] otherwise.
+    piece_face: u32,
+    piece_rot: u32,
     /// The patch's parameter rectangle: u0, u1, v0, v1.
     domain: [f64; 4],
     /// Control points x y z, u fastest, the first (du + 1)(dv + 1) used (weights are 1).
     points: [f64; 3 * POINTS],
+    piece: [f64; 3],
 }
 
 impl PatchRecord {
@@ -99,6 +110,7 @@ impl PatchRecord {
         prepared: &PreparedPatch,
         original: &BezierPatch,
         (object, patch): (u32, u32),
+        piece: Option<Piece>,
     ) -> Option<PatchRecord> {
         if original.is_rational() || original.point_count() > POINTS {
             return None;
@@ -133,8 +145,20 @@ impl PatchRecord {
             object,
             patch,
             degrees: original.degree_u() as u32 | (original.degree_v() as u32) << 16,
+            piece_face: piece.map_or(NO_PIECE, |p| p.face),
+            piece_rot: piece.map_or(0, |p| u32::from(p.rot)),
             domain: [d.u0, d.u1, d.v0, d.v1],
             points,
+            piece: piece.map_or([0.0; 3], |p| [p.origin.0, p.origin.1, p.size]),
+        })
+    }
+
+    fn piece(&self) -> Option<Piece> {
+        (self.piece_face != NO_PIECE).then(|| Piece {
+            face: self.piece_face,
+            rot: self.piece_rot as u8,
+            origin: (self.piece[0], self.piece[1]),
+            size: self.piece[2],
         })
     }
 
@@ -195,6 +219,16 @@ impl PatchRecord {
         if self.kind > KIND_BILINEAR {
             return Some(format!("unknown net kind {}", self.kind));
         }
+        if self.piece_face != NO_PIECE
+            && (self.piece_rot > 3
+                || !self.piece.iter().all(|x| x.is_finite())
+                || self.piece[2] <= 0.0)
+        {
+            return Some(format!(
+                "subdivision piece with {} quarter turns and origin and size {:?}",
+                self.piece_rot, self.piece
+            ));
+        }
         if self.object as usize >= objects {
             return Some(format!(
                 "object {} in a scene of {objects} objects",
@@ -216,14 +250,27 @@ fn unit_square() -> BezierPatch {
 }
 
 /// The patch records of `patches`, or `None` when any patch cannot be mapped (trimmed,
-/// general path, rational).
-pub(super) fn records(patches: &OwnedPatches) -> Option<Vec<PatchRecord>> {
+/// general path, rational); `piece_of(object, patch)` is where a subdivision surface's
+/// patch lies in its quad.
+pub(super) fn records(
+    patches: &OwnedPatches,
+    piece_of: &(dyn Fn(u32, u32) -> Option<Piece> + Sync),
+) -> Option<Vec<PatchRecord>> {
     if patches.trims.iter().any(Option::is_some) {
         return None;
     }
     (0..patches.prepared.len())
         .into_par_iter()
-        .map(|i| PatchRecord::new(&patches.prepared[i], &patches.originals[i], patches.ids[i]))
+        .map(|i| {
+            let (object, patch) = patches.ids[i];
+            let piece = piece_of(object, patch);
+            PatchRecord::new(
+                &patches.prepared[i],
+                &patches.originals[i],
+                patches.ids[i],
+                piece,
+            )
+        })
         .collect()
 }
 
@@ -301,6 +348,10 @@ impl MappedPatches {
     pub(super) fn id(&self, i: usize) -> (u32, u32) {
         let r = &self.records()[i];
         (r.object, r.patch)
+    }
+
+    pub(super) fn piece(&self, i: usize) -> Option<Piece> {
+        self.records()[i].piece()
     }
 }
 

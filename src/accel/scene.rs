@@ -20,6 +20,7 @@ use super::grid::Grid;
 use super::instance::Placement;
 use super::mapped;
 use super::patches::{OwnedPatches, PatchStore};
+use crate::geom::subdiv::Piece;
 use crate::geom::trim::PatchTrim;
 use crate::geom::{Aabb, BezierPatch, DAabb, Ray};
 use crate::kernel::cached::{self, CachedConfig};
@@ -1034,6 +1035,35 @@ impl SceneGeometry {
         }
     }
 
+    /// Where the mapped patches of subdivision surfaces lie in their quads, by object and
+    /// patch number (empty for other objects): what `trace` reports for a scene read from
+    /// a BVH file without its geometry files ([`crate::scene::Object::trace_patch`]).
+    pub fn mapped_pieces(&self, objects: usize) -> Vec<Vec<Piece>> {
+        let mut by_object: Vec<Vec<Option<Piece>>> = vec![Vec::new(); objects];
+        if let PatchStore::Mapped(m) = &self.patches {
+            for i in 0..m.len() {
+                let (object, patch) = m.id(i);
+                if let (Some(piece), Some(list)) = (m.piece(i), by_object.get_mut(object as usize))
+                {
+                    if list.len() <= patch as usize {
+                        list.resize(patch as usize + 1, None);
+                    }
+                    list[patch as usize] = Some(piece);
+                }
+            }
+        }
+        by_object
+            .into_iter()
+            .map(|list| {
+                let patches = 0..list.len() as u32;
+                list.into_iter()
+                    .zip(patches)
+                    .map(|(piece, p)| piece.unwrap_or(Piece::whole(p)))
+                    .collect()
+            })
+            .collect()
+    }
+
     /// Prepares `scene` with a tree from its BVH file ([`FromFile::TreeOnly`]); `path`
     /// names the file in the error when the tree indexes a different number of primitives.
     pub fn with_tree(
@@ -1068,6 +1098,7 @@ impl SceneGeometry {
         key: u64,
         trim_loops: usize,
         parsed: Option<(u64, &[u8])>,
+        piece_of: &(dyn Fn(u32, u32) -> Option<Piece> + Sync),
     ) -> Result<bool, crate::scene::LoadError> {
         let Accel::Bvh(bvh, _) = &self.accel else {
             return Err(crate::scene::LoadError::invalid(
@@ -1079,7 +1110,7 @@ impl SceneGeometry {
             PatchStore::Owned(p)
                 if self.triangles.corners.is_empty() && self.instances.is_empty() =>
             {
-                mapped::records(p)
+                mapped::records(p, piece_of)
             }
             _ => None,
         };

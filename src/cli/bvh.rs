@@ -22,7 +22,17 @@ pub fn run(args: BvhArgs) -> anyhow::Result<ExitCode> {
         _ => None,
     };
     let parsed = parsed.as_ref().map(|(hash, json)| (*hash, json.as_slice()));
-    let with_patches = geometry.save_bvh(&args.output, key, scene.trim_loop_count(), parsed)?;
+    let piece_of = |object: u32, patch: u32| {
+        let object = scene.objects.get(object as usize)?;
+        object.subdivision_piece(patch)
+    };
+    let with_patches = geometry.save_bvh(
+        &args.output,
+        key,
+        scene.trim_loop_count(),
+        parsed,
+        &piece_of,
+    )?;
     eprintln!(
         "wrote {}: {} patches, {} nodes, built in {:.3} s{}",
         args.output.display(),

@@ -179,6 +179,15 @@ fn prepare_from_file(
                 loops,
                 ignored: args.ignore_trims,
             };
+            let mut scene = scene;
+            let pieces = geometry.mapped_pieces(scene.objects.len());
+            for (object, pieces) in scene.objects.iter_mut().zip(pieces) {
+                if !pieces.is_empty() {
+                    object.geometry = crate::scene::Geometry::Subdivision(
+                        crate::geom::subdiv::SubdivisionSurface::reporting(pieces),
+                    );
+                }
+            }
             (scene, *geometry, trims)
         }
         FromFile::TreeOnly(bvh) => {

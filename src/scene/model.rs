@@ -368,6 +368,15 @@ impl Object {
         }
     }
 
+    /// Where patch `patch` of a subdivision surface lies in its quad after the first step,
+    /// `None` for other geometry.
+    pub fn subdivision_piece(&self, patch: u32) -> Option<crate::geom::subdiv::Piece> {
+        match &self.geometry {
+            Geometry::Subdivision(s) => s.pieces.get(patch as usize).copied(),
+            _ => None,
+        }
+    }
+
     /// The object's patches with their trims ([`Geometry::trimmed_patches`]).
     pub fn trimmed_patches(&self) -> Vec<Option<TrimmedPatch>> {
         self.geometry.trimmed_patches()

@@ -135,6 +135,21 @@ impl SubdivisionSurface {
         }
     }
 
+    /// A surface known only by where its patches lie in their quads: a scene read from a
+    /// BVH file, whose patches come from the file, keeps this for `trace`'s report.
+    pub fn reporting(pieces: Vec<Piece>) -> Self {
+        SubdivisionSurface {
+            cage: Mesh {
+                points: Vec::new(),
+                faces: Vec::new(),
+                boundary: Default::default(),
+            },
+            patches: Vec::new(),
+            pieces,
+            stats: Stats::default(),
+        }
+    }
+
     /// Subdivision commutes with affine maps: transforms the cage and rebuilds.
     pub fn transform(&mut self, m: &glam::DAffine3) {
         let mut cage = self.cage.clone();
