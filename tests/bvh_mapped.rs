@@ -374,10 +374,33 @@ fn trace_with_the_file_reports_the_quads_of_a_subdivision_surface() {
     .unwrap();
     let bvh = dir.path().join("cage.bvh");
     assert!(build(&scene, &bvh).contains("with the prepared patches"));
-    // Rays from a sphere of radius 6 around the cube towards points near its centre.
+    let rays = rays_at_the_cube(2000);
+    let fresh = trace_rows(&scene, &rays, &[]);
+    let mapped = trace_rows(&scene, &rays, &["--bvh", bvh.to_str().unwrap()]);
+    assert_eq!(fresh, mapped);
+    let cube_hits: Vec<u32> = fresh
+        .iter()
+        .filter(|r| r[1] == "1" && r[3] == "0")
+        .map(|r| r[4].parse().unwrap())
+        .collect();
+    assert!(cube_hits.len() > 1500, "{} hits", cube_hits.len());
+    assert!(cube_hits.iter().all(|&q| q < 24), "{cube_hits:?}");
+    // Pieces beyond the whole quads were reported through the file: some hit patches lie
+    // near the extraordinary vertices, inside a quad's corner.
+    let near_corner = fresh.iter().filter(|r| {
+        r[1] == "1" && r[3] == "0" && {
+            let (u, v): (f64, f64) = (r[5].parse().unwrap(), r[6].parse().unwrap());
+            u.min(1.0 - u).max(v.min(1.0 - v)) < 0.05
+        }
+    });
+    assert!(near_corner.count() > 0);
+}
+
+/// Rays from a sphere of radius 6 around the cube cage towards points near its centre.
+fn rays_at_the_cube(count: usize) -> String {
     let mut rng = Rng::new(77);
     let mut rays = String::new();
-    for _ in 0..2000 {
+    for _ in 0..count {
         let d = loop {
             let v = Vec3::new(
                 rng.range(-1.0, 1.0),
@@ -400,23 +423,63 @@ fn trace_with_the_file_reports_the_quads_of_a_subdivision_surface() {
             o.x, o.y, o.z, dir.x, dir.y, dir.z
         ));
     }
-    let fresh = trace_rows(&scene, &rays, &[]);
-    let mapped = trace_rows(&scene, &rays, &["--bvh", bvh.to_str().unwrap()]);
+    rays
+}
+
+/// The BVH file of a bare geometry file keeps its scene without the geometry (the framing
+/// camera and light, the geometry's bounds for framing again at another size, the object
+/// names): `render --bvh` and `trace --bvh` on a bare cage read no geometry (the deferred
+/// load has no patches) and give a fresh run's bytes and rows, at an overridden size too.
+#[test]
+fn a_bare_file_renders_from_its_bvh_file_without_reading_its_geometry() {
+    let dir = tempfile::tempdir().unwrap();
+    let cage = dir.path().join("cube.obj");
+    std::fs::copy(testdata("opensubdiv/catmark_cube.obj"), &cage).unwrap();
+    let bvh = dir.path().join("cube.bvh");
+    let (cage_arg, bvh_arg) = (cage.to_str().unwrap(), bvh.to_str().unwrap());
+    let subdivide = ["--subdivide", "catmull-clark"];
+    let o = run(&[
+        "bvh",
+        cage_arg,
+        "--subdivide",
+        "catmull-clark",
+        "-o",
+        bvh_arg,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("with the prepared patches"));
+    let options = LoadOptions { subdivide: true };
+    let opened = mapped::map(&bvh).unwrap();
+    let (deferred, key) =
+        load_scene_keyed(&cage, options, true, Some(opened.cached_scene())).unwrap();
+    let (full, full_key) = load_scene_keyed(&cage, options, false, None).unwrap();
+    assert_eq!(key, full_key);
+    assert_eq!(deferred.objects.len(), full.objects.len());
+    assert_eq!(deferred.objects[0].bezier_patches().len(), 0);
+    assert_eq!(full.objects[0].bezier_patches().len(), 1320);
+    assert_eq!(deferred.camera, full.camera);
+    assert_eq!(deferred.bounds(), full.bounds());
+    let with_file = [subdivide[0], subdivide[1], "--bvh", bvh_arg];
+    for (w, h) in [(32, 32), (40, 24)] {
+        let image = |name: &str, extra: &[&str]| {
+            let out = dir.path().join(name);
+            let o = render(&cage, &out, (w, h), extra);
+            assert!(o.status.success(), "{}", stderr(&o));
+            std::fs::read(out).unwrap()
+        };
+        assert_eq!(
+            image("fresh.png", &subdivide),
+            image("mapped.png", &with_file),
+            "{w}x{h}"
+        );
+    }
+    let rays = rays_at_the_cube(500);
+    let fresh = trace_rows(&cage, &rays, &subdivide);
+    let mapped = trace_rows(
+        &cage,
+        &rays,
+        &[subdivide[0], subdivide[1], "--bvh", bvh_arg],
+    );
     assert_eq!(fresh, mapped);
-    let cube_hits: Vec<u32> = fresh
-        .iter()
-        .filter(|r| r[1] == "1" && r[3] == "0")
-        .map(|r| r[4].parse().unwrap())
-        .collect();
-    assert!(cube_hits.len() > 1500, "{} hits", cube_hits.len());
-    assert!(cube_hits.iter().all(|&q| q < 24), "{cube_hits:?}");
-    // Pieces beyond the whole quads were reported through the file: some hit patches lie
-    // near the extraordinary vertices, inside a quad's corner.
-    let near_corner = fresh.iter().filter(|r| {
-        r[1] == "1" && r[3] == "0" && {
-            let (u, v): (f64, f64) = (r[5].parse().unwrap(), r[6].parse().unwrap());
-            u.min(1.0 - u).max(v.min(1.0 - v)) < 0.05
-        }
-    });
-    assert!(near_corner.count() > 0);
+    assert!(fresh.iter().filter(|r| r[1] == "1").count() > 400);
 }

@@ -339,9 +339,10 @@ pub struct KernelArgs {
     #[arg(long)]
     pub ignore_trims: bool,
     /// Load the BVH from this file (written by `patchtrace bvh`) instead of building it.
-    /// A file that holds the prepared patches is mapped and the scene's geometry files are
-    /// not parsed, only hashed; a file built from other inputs (a geometry file's bytes,
-    /// a transform, `--ignore-trims`) is refused.
+    /// A file that holds the prepared patches is mapped and the scene's geometry files (or
+    /// a bare geometry file itself: the file keeps its framing) are not parsed, only
+    /// hashed; a file built from other inputs (a geometry file's bytes, a transform,
+    /// `--ignore-trims`, `--subdivide`) is refused.
     #[arg(long, value_name = "FILE")]
     pub bvh: Option<PathBuf>,
     /// Acceleration structure over the patches.

@@ -19,7 +19,7 @@ pub fn run(args: BvhArgs) -> anyhow::Result<ExitCode> {
         Some(crate::scene::load::InputKind::Ron) => {
             crate::scene::ron_format::parsed_scene(&args.scene)
         }
-        _ => None,
+        _ => crate::scene::load::bare_shell_section(&args.scene, &scene)?,
     };
     let parsed = parsed.as_ref().map(|(hash, json)| (*hash, json.as_slice()));
     let piece_of = |object: u32, patch: u32| {

@@ -167,7 +167,11 @@ fn prepare_from_file(
 ) -> anyhow::Result<Prepared> {
     let start = Instant::now();
     let opened = crate::accel::mapped::map(bvh_path)?;
-    let parsed = Some(opened.cached_scene());
+    // A bare file's shell stands in for its scene only where the file holds the patches:
+    // a tree-only file's geometry is built from the scene, which must then be read whole.
+    let bare =
+        crate::scene::load::InputKind::of(scene_path) != Some(crate::scene::load::InputKind::Ron);
+    let parsed = (!bare || opened.has_patches()).then(|| opened.cached_scene());
     let (scene, source) = load_keyed(scene_path, mesh, quiet, (true, parsed))?;
     let load_seconds = start.elapsed().as_secs_f64();
     let start = Instant::now();

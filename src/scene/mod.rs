@@ -5,6 +5,7 @@
 //! expected`; every writer writes to a temporary name and renames.
 
 pub mod animation;
+pub mod bare_shell;
 pub mod bpt;
 pub mod cage;
 pub mod convert;

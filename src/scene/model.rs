@@ -13,7 +13,7 @@ use crate::geom::subdiv::SubdivisionSurface;
 use crate::geom::trim::{AxisMap, Coverage, PatchTrim, TrimError, TrimLoop, TrimRegion};
 
 /// Camera per the DESIGN.md contract.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Camera {
     pub eye: DVec3,
     pub look_at: DVec3,
@@ -57,7 +57,7 @@ pub fn check_film_pixels(width: u32, height: u32) -> Result<(), String> {
     Ok(())
 }
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Light {
     Point {
         position: DVec3,
@@ -71,7 +71,7 @@ pub enum Light {
 }
 
 /// Whitted material. Highlight model is Phong unless `blinn` is set.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Material {
     pub name: String,
     pub diffuse: Vec3,
@@ -453,6 +453,10 @@ pub struct Scene {
     pub lights: Vec<Light>,
     pub materials: Vec<Material>,
     pub objects: Vec<Object>,
+    /// For a bare file's scene read from its BVH file without the geometry
+    /// ([`crate::scene::bare_shell`]), the bounds of that geometry, which framing uses;
+    /// `None`: the objects' own.
+    pub unread_bounds: Option<DAabb>,
 }
 
 /// Default recursion limit for reflection and refraction (issue 3).
@@ -462,9 +466,11 @@ pub const DEFAULT_AMBIENT: f32 = 0.1;
 
 impl Scene {
     pub fn bounds(&self) -> DAabb {
-        self.objects
-            .iter()
-            .fold(DAabb::EMPTY, |acc, o| acc.union(&o.bounds()))
+        self.unread_bounds.unwrap_or_else(|| {
+            self.objects
+                .iter()
+                .fold(DAabb::EMPTY, |acc, o| acc.union(&o.bounds()))
+        })
     }
 
     /// A scene for bare geometry, z up: a camera that frames it and one light
@@ -493,6 +499,7 @@ impl Scene {
             lights: Vec::new(),
             materials: vec![Material::default_named("default")],
             objects,
+            unread_bounds: None,
         };
         scene.frame_bare(up);
         scene

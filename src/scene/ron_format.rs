@@ -534,6 +534,7 @@ fn build_scene(
         lights,
         materials,
         objects,
+        unread_bounds: None,
     })
 }
 
