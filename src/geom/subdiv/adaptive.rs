@@ -123,11 +123,13 @@ pub fn build(cage: &Mesh) -> (Vec<BezierPatch>, Vec<Piece>, Stats) {
         },
     };
     loop {
-        let refined = level_patches(&mut level, &mut out);
+        // One topology per level, shared by both passes over it.
+        let topo = Topology::new(&level.mesh);
+        let refined = level_patches(&mut level, &topo, &mut out);
         if refined.is_empty() {
             break;
         }
-        level = next_level(level, &refined);
+        level = next_level(level, &topo, &refined);
     }
     (out.patches, out.pieces, out.stats)
 }
@@ -146,8 +148,7 @@ fn limit_of(level: &mut Level, topo: &Topology, v: u32) -> DVec3 {
 
 /// Emits this level's regular patches and final extraordinary children; returns the
 /// faces to refine.
-fn level_patches(level: &mut Level, out: &mut Output) -> Vec<u32> {
-    let topo = Topology::new(&level.mesh);
+fn level_patches(level: &mut Level, topo: &Topology, out: &mut Output) -> Vec<u32> {
     let targets: Vec<u32> = (0..level.pieces.len() as u32)
         .filter(|&f| level.pieces[f as usize].is_some())
         .collect();
@@ -155,8 +156,8 @@ fn level_patches(level: &mut Level, out: &mut Output) -> Vec<u32> {
     let mut emitted: HashMap<u32, usize> = HashMap::new();
     for &f in &targets {
         let face = level.mesh.faces[f as usize].clone();
-        if face.iter().all(|&v| is_regular(&level.mesh, &topo, v)) {
-            let net = regular_net(level, &topo, f);
+        if face.iter().all(|&v| is_regular(&level.mesh, topo, v)) {
+            let net = regular_net(level, topo, f);
             let index = out.push(&net, level.pieces[f as usize].expect("target"));
             emitted.insert(f, index);
             out.stats.regular += 1;
@@ -171,13 +172,13 @@ fn level_patches(level: &mut Level, out: &mut Output) -> Vec<u32> {
     let mut refine_now = Vec::new();
     for &f in &irregular {
         let face = &level.mesh.faces[f as usize];
-        let single = face[1..].iter().all(|&v| is_regular(&level.mesh, &topo, v));
+        let single = face[1..].iter().all(|&v| is_regular(&level.mesh, topo, v));
         if level.depth >= 2 && single {
             groups.entry(face[0]).or_default().push(f);
         } else if level.depth >= MAX_LEVELS {
             // Unreachable for a manifold cage (two extraordinary vertices never share a
             // face below level 2); ends the refinement whatever the input.
-            let net = regular_net(level, &topo, f);
+            let net = regular_net(level, topo, f);
             out.push(&net, level.pieces[f as usize].expect("target"));
             out.stats.extraordinary_ends += 1;
         } else {
@@ -188,9 +189,9 @@ fn level_patches(level: &mut Level, out: &mut Output) -> Vec<u32> {
     group_keys.sort_unstable();
     for ev in group_keys {
         let faces = &groups[&ev];
-        if level.depth >= MAX_LEVELS || hull_is_final(&level.mesh, &topo, faces) {
+        if level.depth >= MAX_LEVELS || hull_is_final(&level.mesh, topo, faces) {
             for &f in faces {
-                let net = final_net(level, &topo, f);
+                let net = final_net(level, topo, f);
                 out.push(&net, level.pieces[f as usize].expect("target"));
                 out.stats.extraordinary_ends += 1;
             }
@@ -304,8 +305,7 @@ fn overlap_edge(patch: &mut BezierPatch, m: usize) {
 
 /// Refines `faces` of `level` by one step: the next level's targets are their children,
 /// with the limit positions carried over.
-fn next_level(level: Level, faces: &[u32]) -> Level {
-    let topo = Topology::new(&level.mesh);
+fn next_level(level: Level, topo: &Topology, faces: &[u32]) -> Level {
     // Two rings of faces around what is refined: enough for every child's 1-ring to get
     // its exact new points (see `refine`).
     let mut selected: HashSet<u32> = faces.iter().copied().collect();
@@ -319,7 +319,7 @@ fn next_level(level: Level, faces: &[u32]) -> Level {
     }
     let mut selected: Vec<u32> = selected.into_iter().collect();
     selected.sort_unstable();
-    let r = refine(&level.mesh, &topo, &selected);
+    let r = refine(&level.mesh, topo, &selected);
     let position: HashMap<u32, usize> = selected.iter().enumerate().map(|(i, &f)| (f, i)).collect();
     let mut pieces = vec![None; r.mesh.faces.len()];
     let mut limits = vec![None; r.mesh.points.len()];
