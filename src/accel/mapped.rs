@@ -16,10 +16,10 @@
 //! | … | 8 | [`checksum`] of the section before it |
 //!
 //! Then the scene section, the scene file's parse for `render --bvh` to skip the RON parse
-//! when the text is unchanged: the xxh3-64 of the scene file's bytes (`u64`), the length
-//! `u64` of the JSON that follows (`ron_format::SceneFile`, or for a bare geometry file its
-//! scene without geometry, `scene::bare_shell::BareShell`), the JSON, and the [`checksum`]
-//! of the section.
+//! when the text is unchanged: the xxh3-64 of the scene file's bytes (`u64`; for a bare
+//! geometry file the key of its inputs), the length `u64` of the JSON that follows
+//! (`ron_format::SceneFile`, or for a bare geometry file its scene without geometry,
+//! `scene::bare_shell::BareShell`), the JSON, and the [`checksum`] of the section.
 //!
 //! Records hold what the render reads of a patch: the `f32` net of the bicubic or bilinear
 //! fast path, its box, its (object, patch) number, and the `f64` control points and domain
@@ -263,14 +263,9 @@ pub(super) fn records(
     (0..patches.prepared.len())
         .into_par_iter()
         .map(|i| {
-            let (object, patch) = patches.ids[i];
+            let id @ (object, patch) = patches.ids[i];
             let piece = piece_of(object, patch);
-            PatchRecord::new(
-                &patches.prepared[i],
-                &patches.originals[i],
-                patches.ids[i],
-                piece,
-            )
+            PatchRecord::new(&patches.prepared[i], &patches.originals[i], id, piece)
         })
         .collect()
 }
@@ -483,7 +478,7 @@ pub fn map(path: &Path) -> Result<Opened, LoadError> {
 impl Opened {
     /// The scene's parse the file keeps: the xxh3-64 of the scene file's bytes and the
     /// JSON of its serde mirror (`scene::ron_format::ParsedScene`), or for a bare geometry
-    /// file the hash of its bytes and its scene's `scene::bare_shell::BareShell`; empty
+    /// file the key of its inputs and its scene's `scene::bare_shell::BareShell`; empty
     /// when none.
     pub fn cached_scene(&self) -> (u64, &[u8]) {
         (self.scene.0, &self.map[self.scene.1.clone()])

@@ -19,7 +19,8 @@ pub fn run(args: BvhArgs) -> anyhow::Result<ExitCode> {
         Some(crate::scene::load::InputKind::Ron) => {
             crate::scene::ron_format::parsed_scene(&args.scene)
         }
-        _ => crate::scene::load::bare_shell_section(&args.scene, &scene)?,
+        // A bare file's shell, under the key of its inputs.
+        _ => crate::scene::bare_shell::BareShell::json_of(&scene).map(|json| (source, json)),
     };
     let parsed = parsed.as_ref().map(|(hash, json)| (*hash, json.as_slice()));
     let piece_of = |object: u32, patch: u32| {

@@ -1,6 +1,7 @@
 //! A bare geometry file's scene without its geometry: the framing camera and light, the
 //! materials and the objects' names and materials. The BVH file of a bare file keeps it
-//! (in the scene section, where a RON scene keeps its parse), so that `render --bvh` and
+//! (in the scene section, where a RON scene keeps its parse, under the key of the bare
+//! file's inputs instead of the hash of a scene text), so that `render --bvh` and
 //! `trace --bvh` on a bare file read no geometry: the framing cannot be made again from
 //! the file's patches, as it comes from the control points' bounds, not the tight boxes
 //! the records hold.

@@ -161,8 +161,8 @@ pub fn load_scene_with(path: &Path, options: LoadOptions) -> Result<Scene, LoadE
 /// hashed but not parsed, and the objects they feed get no geometry: for a caller that
 /// finds it prepared in a BVH file with this key. Bare geometry is keyed by its bytes and
 /// `options`, and read unless `defer` and `parsed` holds the shell of its scene for the
-/// same bytes ([`bare_shell_section`]): its default camera frames the geometry, so only a
-/// kept shell stands in for it. `parsed` is what a BVH file keeps: a RON scene's
+/// same key ([`BareShell`](super::bare_shell::BareShell)): its default camera frames the
+/// geometry, so only a kept shell stands in for it. `parsed` is what a BVH file keeps: a RON scene's
 /// [`ron_format::parsed_scene`] or a bare file's shell.
 pub fn load_scene_keyed(
     path: &Path,
@@ -180,30 +180,17 @@ pub fn load_scene_keyed(
     key.text("bare geometry");
     key.number(u64::from(options.subdivide));
     key.file(path)?;
-    // With `defer`, the shell the BVH file keeps for these very bytes stands in for the
-    // file's scene; its geometry comes from the BVH file.
-    let digest = key.file_digest(path);
+    // With `defer`, the shell the BVH file keeps for these very inputs (its hash is their
+    // key) stands in for the file's scene; its geometry comes from the BVH file.
+    let key = key.finish();
     let kept = parsed
-        .filter(|(hash, _)| defer && Some(*hash) == digest)
+        .filter(|(hash, _)| defer && *hash == key)
         .and_then(|(_, json)| super::bare_shell::BareShell::scene_of(json));
     let scene = match kept {
         Some(scene) => scene,
         None => load_scene_with(path, options)?,
     };
-    Ok((scene, key.finish()))
-}
-
-/// What a BVH file of the bare geometry file at `path` keeps of its `scene` (the scene
-/// section: the hash of the file's bytes and the scene's [`BareShell`] as JSON).
-///
-/// [`BareShell`]: super::bare_shell::BareShell
-pub fn bare_shell_section(path: &Path, scene: &Scene) -> Result<Option<(u64, Vec<u8>)>, LoadError> {
-    let mut key = super::source_key::SourceKey::new();
-    key.file(path)?;
-    let digest = key
-        .file_digest(path)
-        .expect("the key has just read the file");
-    Ok(super::bare_shell::BareShell::json_of(scene).map(|json| (digest, json)))
+    Ok((scene, key))
 }
 
 /// [`load_scene_with`], with what the reader noted about the file beyond the scene (a

@@ -75,11 +75,6 @@ impl SourceKey {
         Ok(())
     }
 
-    /// The hash of the bytes of a file this key has read.
-    pub fn file_digest(&self, path: &Path) -> Option<u64> {
-        self.files.get(path).copied()
-    }
-
     pub fn finish(&self) -> u64 {
         self.hasher.digest()
     }

@@ -75,9 +75,9 @@ pub const TRANSFORM_ULPS: f64 = 8.0;
 /// but a ray that passes a shared edge within the transform's rounding may be inside the
 /// ray-space net of patch A and outside A's exact world box, while neighbour B's ray-space
 /// net lets it through on A's side. Culling A by its world box then loses the hit, or
-/// hands the ray to a surface behind (measured: 1 ray in 30,000 aimed at the shared
-/// edges of a subdivision-surface bipyramid, and rays lying in a flat patch's plane with a
-/// direction component of ±1e-18). A ray-space coordinate is within [`TRANSFORM_ULPS`]
+/// hands the ray to a surface behind (measured without the margin: 1 ray in 180,000 aimed
+/// at the shared edges and extraordinary vertices of three subdivision surfaces went
+/// through the cube's, `tests/subdiv_surface.rs`). A ray-space coordinate is within [`TRANSFORM_ULPS`]
 /// ulps of its exact value at the ray-space scale `|p - o| / |d|`, which is at most two
 /// ulps of `|p - o|` back in world units, on each of the two axes across the ray: within
 /// `2 √2 TRANSFORM_ULPS` ulps (about 22.6) of `|p - o|` of the ray. 32 also covers the
