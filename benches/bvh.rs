@@ -17,8 +17,8 @@ use std::time::Instant;
 
 use glam::{DAffine3, DVec3, Vec3};
 use patchtrace::accel::bvh::Bvh;
+use patchtrace::formats::bpt::read_bpt;
 use patchtrace::geom::{Aabb, Ray};
-use patchtrace::scene::bpt::read_bpt;
 
 /// SplitMix64 (Steele, Lea and Flood 2014).
 struct Rng(u64);

@@ -20,9 +20,9 @@ use support::process_cpu_seconds;
 
 use patchtrace::accel::mapped;
 use patchtrace::accel::scene::{FromFile, SceneGeometry};
+use patchtrace::formats::ron_format::parsed_scene;
+use patchtrace::formats::{LoadOptions, load_scene_keyed};
 use patchtrace::scene::generate::{TEAPOT_BPT, TeapotsSpec, teapots_scene};
-use patchtrace::scene::ron_format::parsed_scene;
-use patchtrace::scene::{LoadOptions, load_scene_keyed};
 
 /// Runs `f`, returning its value and its (wall, CPU) seconds.
 fn timed<T>(f: impl FnOnce() -> T) -> (T, f64, f64) {

@@ -10,7 +10,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use patchtrace::scene::iges::{directory, read_iges, records};
+use patchtrace::formats::cad::iges::{directory, read_iges, records};
 
 #[allow(dead_code)] // benches use a part of the test helpers
 #[path = "../tests/lib/iges_support/mod.rs"]

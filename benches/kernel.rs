@@ -14,6 +14,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use glam::DVec3;
+use patchtrace::formats::bpt::read_bpt;
 use patchtrace::geom::ulp::ulp_of;
 use patchtrace::kernel::KernelStats;
 use patchtrace::kernel::subdivision::{
@@ -21,7 +22,6 @@ use patchtrace::kernel::subdivision::{
 };
 use patchtrace::render::camera::CameraRays;
 use patchtrace::scene::Camera;
-use patchtrace::scene::bpt::read_bpt;
 
 /// Timed runs after the warm-up; the median is reported.
 const RUNS: usize = 7;

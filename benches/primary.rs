@@ -11,10 +11,11 @@ use std::path::Path;
 use std::time::Instant;
 
 use patchtrace::accel::scene::{Precision, QueryStats, SceneGeometry};
+use patchtrace::formats::{bpt::read_bpt, load_scene};
 use patchtrace::geom::Ray;
 use patchtrace::kernel::subdivision::SubdivisionConfig;
 use patchtrace::render::camera::CameraRays;
-use patchtrace::scene::{Geometry, Object, Scene, Surface, bpt::read_bpt, load_scene};
+use patchtrace::scene::{Geometry, Object, Scene, Surface};
 use patchtrace::tessellate::{TessellationMode, tessellate_scene};
 
 #[path = "support/mod.rs"]

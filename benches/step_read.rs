@@ -16,7 +16,7 @@ mod support;
 
 use std::time::Instant;
 
-use patchtrace::scene::step::{read_step, records};
+use patchtrace::formats::cad::step::{read_step, records};
 use support::{median, process_cpu_seconds as cpu_seconds};
 
 const RUNS: usize = 5;

@@ -15,6 +15,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use patchtrace::accel::scene::{Precision, QueryStats, SceneGeometry};
+use patchtrace::formats::write::write_scene_as;
+use patchtrace::formats::{LoadOptions, load_scene_with};
 use patchtrace::geom::Ray;
 use patchtrace::kernel::secondary::DEFAULT_ULPS;
 use patchtrace::kernel::subdivision::SubdivisionConfig;
@@ -23,8 +25,7 @@ use patchtrace::render::camera::CameraRays;
 use patchtrace::render::integrator::{Integrator, TraceSettings};
 use patchtrace::render::plan::EffectPlan;
 use patchtrace::render::renderer::render_image;
-use patchtrace::scene::write::write_scene_as;
-use patchtrace::scene::{LoadOptions, Scene, load_scene_with};
+use patchtrace::scene::Scene;
 
 const RUNS: usize = 5;
 const SIZE: u32 = 512;

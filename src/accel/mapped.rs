@@ -39,6 +39,7 @@ use rayon::prelude::*;
 
 use super::bvh::{Bvh, BvhFileError, checksum};
 use super::patches::OwnedPatches;
+use crate::formats::LoadError;
 use crate::geom::bezier::ParamRect;
 use crate::geom::subdiv::Piece;
 use crate::geom::{Aabb, BezierPatch};
@@ -46,7 +47,6 @@ use crate::kernel::subdivision::PreparedPatch;
 use crate::kernel::subdivision::bicubic::Net;
 use crate::kernel::subdivision::bilinear::BilinearNet;
 use crate::kernel::subdivision::prepared::Prepared;
-use crate::scene::LoadError;
 
 /// The key a scene's BVH file records: its inputs' key (`scene::source_key`) with what else
 /// decides the prepared patches: `--ignore-trims`, and whether this host prepares bilinear

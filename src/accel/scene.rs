@@ -1070,14 +1070,14 @@ impl SceneGeometry {
         scene: &Scene,
         bvh: Bvh,
         path: &std::path::Path,
-    ) -> Result<SceneGeometry, crate::scene::LoadError> {
+    ) -> Result<SceneGeometry, crate::formats::LoadError> {
         let split = Split::of(scene);
         let prototypes = split.prepare_prototypes();
         let patches = collect_patches(&split.own);
         let triangles = collect_triangles(&split.own);
         let instances = place(&split.instances, &prototypes, patches.originals.len());
         if bvh.prim_count() != patches.originals.len() + triangles.corners.len() + instances.len() {
-            return Err(crate::scene::LoadError::invalid(
+            return Err(crate::formats::LoadError::invalid(
                 path,
                 "the BVH indexes a different number of patches than the scene; rebuild it with `patchtrace bvh`",
             ));
@@ -1099,9 +1099,9 @@ impl SceneGeometry {
         trim_loops: usize,
         parsed: Option<(u64, &[u8])>,
         piece_of: &(dyn Fn(u32, u32) -> Option<Piece> + Sync),
-    ) -> Result<bool, crate::scene::LoadError> {
+    ) -> Result<bool, crate::io::OutputError> {
         let Accel::Bvh(bvh, _) = &self.accel else {
-            return Err(crate::scene::LoadError::invalid(
+            return Err(crate::io::OutputError::invalid(
                 path,
                 "the geometry was prepared with a grid, which has no BVH to write",
             ));
@@ -1114,7 +1114,7 @@ impl SceneGeometry {
             }
             _ => None,
         };
-        crate::scene::write::write_atomic(path, |w| {
+        crate::io::write_atomic(path, |w| {
             mapped::write(w, bvh, key, (records.as_deref(), trim_loops), parsed)
         })?;
         Ok(records.is_some())

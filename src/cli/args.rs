@@ -288,8 +288,8 @@ pub enum SubdivideChoice {
 }
 
 impl MeshArgs {
-    pub fn load_options(&self) -> crate::scene::LoadOptions {
-        crate::scene::LoadOptions {
+    pub fn load_options(&self) -> crate::formats::LoadOptions {
+        crate::formats::LoadOptions {
             subdivide: self.subdivide == Some(SubdivideChoice::CatmullClark),
         }
     }
@@ -655,7 +655,7 @@ impl ImageSizeArgs {
         camera
             .check_size()
             .map_err(|e| crate::cli::BadArgument(format!("--width/--height: {e}")))?;
-        crate::scene::load::reframe(path, scene, self.up)?;
+        crate::formats::load::reframe(path, scene, self.up)?;
         Ok(())
     }
 }

@@ -5,7 +5,7 @@ use std::process::ExitCode;
 
 use crate::bench::stability::{self, KernelPath, SuiteSize, report};
 use crate::cli::args::StabilityArgs;
-use crate::scene::write::write_atomic;
+use crate::io::write_atomic;
 
 pub fn stability(args: StabilityArgs) -> anyhow::Result<ExitCode> {
     let size = if args.full {

@@ -8,10 +8,10 @@ use anyhow::Context;
 use crate::bench::accuracy::{self, Method, plot};
 use crate::cli::args::AccuracyArgs;
 use crate::cli::setup::load;
+use crate::formats::error::read_text;
+use crate::formats::rays::{RayQuery, parse_rays};
+use crate::io::write_atomic;
 use crate::render::camera::CameraRays;
-use crate::scene::error::read_text;
-use crate::scene::rays::{RayQuery, parse_rays};
-use crate::scene::write::write_atomic;
 
 pub fn run(args: AccuracyArgs) -> anyhow::Result<ExitCode> {
     let mut scene = load(&args.scene, &args.mesh, args.quiet)?;

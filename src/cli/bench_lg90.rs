@@ -6,8 +6,8 @@ use std::process::ExitCode;
 use crate::bench::lg90::{self, CASES, Config, Method, report};
 use crate::cli::args::Lg90Args;
 use crate::cli::setup::thread_pool;
+use crate::io::write_atomic;
 use crate::kernel::cached::DEFAULT_CACHE_BYTES;
-use crate::scene::write::write_atomic;
 
 pub fn run(args: Lg90Args) -> anyhow::Result<ExitCode> {
     anyhow::ensure!(args.size > 0, "--size must be at least 1");

@@ -15,9 +15,9 @@ pub fn run(args: BvhArgs) -> anyhow::Result<ExitCode> {
     let geometry = build_bvh(&scene, args.quiet);
     let build = start.elapsed().as_secs_f64();
     let key = crate::accel::mapped::key(source, false);
-    let parsed = match crate::scene::load::InputKind::of(&args.scene) {
-        Some(crate::scene::load::InputKind::Ron) => {
-            crate::scene::ron_format::parsed_scene(&args.scene)
+    let parsed = match crate::formats::load::InputKind::of(&args.scene) {
+        Some(crate::formats::load::InputKind::Ron) => {
+            crate::formats::ron_format::parsed_scene(&args.scene)
         }
         // A bare file's shell, under the key of its inputs.
         _ => crate::scene::bare_shell::BareShell::json_of(&scene).map(|json| (source, json)),

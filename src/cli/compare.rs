@@ -16,6 +16,7 @@ use crate::cli::args::CompareArgs;
 use crate::cli::setup::{build_bvh, load, tessellate, thread_pool};
 use crate::diff::heatmap::heat_map;
 use crate::diff::{DiffOptions, Image, diff_images};
+use crate::io::write_atomic;
 use crate::kernel::secondary::DEFAULT_ULPS;
 use crate::kernel::subdivision::SubdivisionConfig;
 use crate::render::film::Film;
@@ -23,7 +24,6 @@ use crate::render::integrator::{Integrator, TraceSettings};
 use crate::render::plan::EffectPlan;
 use crate::render::renderer::render_image;
 use crate::scene::Scene;
-use crate::scene::write::write_atomic;
 use crate::tessellate::TessellationMode;
 
 /// One line of the table.

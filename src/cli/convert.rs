@@ -5,8 +5,8 @@ use std::process::ExitCode;
 
 use crate::cli::args::ConvertArgs;
 use crate::cli::setup::load;
+use crate::formats::write::write_scene_as;
 use crate::scene::convert::convert_scene;
-use crate::scene::write::write_scene_as;
 
 pub fn run(args: ConvertArgs) -> anyhow::Result<ExitCode> {
     let scene = load(&args.input, &args.mesh, args.quiet)?;

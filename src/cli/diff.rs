@@ -9,7 +9,7 @@ use crate::cli::EXIT_FAILURE;
 use crate::cli::args::{DiffArgs, HeatmapChoice};
 use crate::diff::heatmap::heat_map;
 use crate::diff::{DiffError, DiffOptions, DiffReport, Exceeded, Space, diff_images, read_image};
-use crate::scene::LoadError;
+use crate::formats::LoadError;
 
 /// The JSON document: the report plus the inputs and the limits exceeded.
 #[derive(Serialize)]

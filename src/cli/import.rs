@@ -4,7 +4,7 @@ use std::process::ExitCode;
 
 use crate::cli::args::ImportArgs;
 use crate::cli::setup::load;
-use crate::scene::write::write_scene_as;
+use crate::formats::write::write_scene_as;
 
 pub fn run(args: ImportArgs) -> anyhow::Result<ExitCode> {
     let scene = load(&args.input, &args.mesh, args.quiet)?;

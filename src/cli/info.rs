@@ -4,7 +4,7 @@ use std::io::Write;
 use std::process::ExitCode;
 
 use crate::cli::args::InfoArgs;
-use crate::scene::load::{InputKind, load_scene_noted};
+use crate::formats::load::{InputKind, load_scene_noted};
 use crate::scene::summary::summarize;
 
 pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
@@ -100,7 +100,10 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
         writeln!(out, "{note}")?;
     }
     if InputKind::of(&args.scene) == Some(InputKind::Iges) {
-        for line in crate::scene::iges::read_iges(&args.scene)?.report.lines() {
+        for line in crate::formats::cad::iges::read_iges(&args.scene)?
+            .report
+            .lines()
+        {
             writeln!(out, "{line}")?;
         }
     }

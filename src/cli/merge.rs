@@ -9,10 +9,10 @@ use std::process::ExitCode;
 use exr::prelude::{AnyChannel, FlatSamples};
 
 use crate::cli::args::MergeArgs;
+use crate::formats::LoadError;
 use crate::render::film::{Film, ImageFormat};
 use crate::render::piece::{Piece, PieceInfo, PiecePixels, read_piece, write_exr, write_png};
 use crate::render::window::{Window, check_cover};
-use crate::scene::LoadError;
 
 pub fn run(args: MergeArgs) -> anyhow::Result<ExitCode> {
     let format = ImageFormat::of(&args.output).ok_or_else(|| {

@@ -85,8 +85,12 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
 }
 
 fn exit_code_for(err: &anyhow::Error) -> u8 {
-    if err.downcast_ref::<crate::scene::LoadError>().is_some()
-        || err.downcast_ref::<crate::scene::ParseError>().is_some()
+    if err.downcast_ref::<crate::formats::LoadError>().is_some()
+        || err.downcast_ref::<crate::formats::ParseError>().is_some()
+        || err.downcast_ref::<crate::io::OutputError>().is_some()
+        || err
+            .downcast_ref::<crate::bench::lg90::CaseError>()
+            .is_some()
         || err.downcast_ref::<BadArgument>().is_some()
         || err
             .downcast_ref::<crate::tessellate::TessellateError>()

@@ -9,6 +9,7 @@ use serde::Serialize;
 
 use crate::cli::args::{Aov, RenderArgs};
 use crate::cli::setup::{Prepared, precision, prepare, thread_pool};
+use crate::formats::LoadError;
 use crate::render::aov;
 use crate::render::film::{ImageFormat, sibling, write_effort_png};
 use crate::render::integrator::{Integrator, TraceSettings};
@@ -18,7 +19,6 @@ use crate::render::renderer::{RenderJob, render};
 use crate::render::sampler::SampleCount;
 use crate::render::stats::{PhaseTimes, RayReport};
 use crate::render::window::Window;
-use crate::scene::LoadError;
 use crate::scene::animation::frame_path;
 
 /// How many samples a render took.

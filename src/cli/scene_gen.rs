@@ -3,9 +3,9 @@
 use std::process::ExitCode;
 
 use crate::cli::args::TeapotsArgs;
-use crate::scene::LoadError;
+use crate::formats::LoadError;
+use crate::io::write_atomic;
 use crate::scene::generate::{TEAPOT_BPT, TeapotsSpec, teapots_scene};
-use crate::scene::write::write_atomic;
 
 pub fn teapots(args: TeapotsArgs) -> anyhow::Result<ExitCode> {
     if args.output.extension().is_none_or(|e| e != "ron") {

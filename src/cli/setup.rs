@@ -11,12 +11,13 @@ use crate::cli::args::{
     AccelChoice, HeuristicChoice, KernelArgs, KernelChoice, MeshArgs, PrecisionChoice,
     TerminationChoice,
 };
+use crate::formats::{load_scene_keyed, load_scene_with};
 use crate::kernel::cached::{CachedConfig, DEFAULT_CACHE_BYTES, DEFAULT_MAX_DEPTH};
 use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig, Termination};
 use crate::kernel::toth::TothConfig;
 use crate::render::camera::CameraRays;
 use crate::render::plan::TrimEffect;
-use crate::scene::{Camera, Scene, load_scene_keyed, load_scene_with};
+use crate::scene::{Camera, Scene};
 use crate::tessellate::{
     TessellateError, TessellationMode, TessellationReport, tessellate_scene_with,
 };
@@ -95,7 +96,7 @@ pub struct Prepared {
 
 /// Reads the scene at `path` with `--subdivide`'s options, under a spinner when the file is
 /// large ([`while_reading`](crate::progress::while_reading)), unless `quiet`.
-pub fn load(path: &Path, mesh: &MeshArgs, quiet: bool) -> Result<Scene, crate::scene::LoadError> {
+pub fn load(path: &Path, mesh: &MeshArgs, quiet: bool) -> Result<Scene, crate::formats::LoadError> {
     crate::progress::while_reading(quiet, path, || load_scene_with(path, mesh.load_options()))
 }
 
@@ -148,7 +149,7 @@ pub fn load_keyed(
     mesh: &MeshArgs,
     quiet: bool,
     (defer, parsed): (bool, Option<(u64, &[u8])>),
-) -> Result<(Scene, u64), crate::scene::LoadError> {
+) -> Result<(Scene, u64), crate::formats::LoadError> {
     crate::progress::while_reading(quiet, path, || {
         load_scene_keyed(path, mesh.load_options(), defer, parsed)
     })
@@ -169,8 +170,8 @@ fn prepare_from_file(
     let opened = crate::accel::mapped::map(bvh_path)?;
     // A bare file's shell stands in for its scene only where the file holds the patches:
     // a tree-only file's geometry is built from the scene, which must then be read whole.
-    let bare =
-        crate::scene::load::InputKind::of(scene_path) != Some(crate::scene::load::InputKind::Ron);
+    let bare = crate::formats::load::InputKind::of(scene_path)
+        != Some(crate::formats::load::InputKind::Ron);
     let parsed = (!bare || opened.has_patches()).then(|| opened.cached_scene());
     let (scene, source) = load_keyed(scene_path, mesh, quiet, (true, parsed))?;
     let load_seconds = start.elapsed().as_secs_f64();
@@ -196,8 +197,8 @@ fn prepare_from_file(
         }
         FromFile::TreeOnly(bvh) => {
             // A RON scene was read without its geometry files; bare geometry with it.
-            let mut scene = match crate::scene::load::InputKind::of(scene_path) {
-                Some(crate::scene::load::InputKind::Ron) => load(scene_path, mesh, quiet)?,
+            let mut scene = match crate::formats::load::InputKind::of(scene_path) {
+                Some(crate::formats::load::InputKind::Ron) => load(scene_path, mesh, quiet)?,
                 _ => scene,
             };
             let trims = TrimEffect::of(&scene, args.ignore_trims);

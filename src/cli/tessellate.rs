@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use crate::cli::args::TessellateArgs;
 use crate::cli::setup::{load, tessellate};
-use crate::scene::LoadError;
+use crate::formats::LoadError;
 use crate::tessellate::{MeshFormat, TessellationMode, TessellationReport, write_mesh_scene};
 
 /// Triangles per patch when no mode is given: Dammertz's coarsest table row.

@@ -10,10 +10,11 @@ use rayon::prelude::*;
 use crate::accel::scene::{Precision, QueryStats, SceneGeometry, SceneHit};
 use crate::cli::args::TraceArgs;
 use crate::cli::setup::{precision, prepare, thread_pool};
+use crate::formats::LoadError;
+use crate::formats::rays::{RayChunks, RayQuery};
 use crate::geom::Ray;
-use crate::scene::rays::{RayChunks, RayQuery};
-use crate::scene::write::write_atomic;
-use crate::scene::{LoadError, Scene};
+use crate::io::write_atomic;
+use crate::scene::Scene;
 
 /// The header line of the contract.
 pub const TRACE_HEADER: &str = "ray,hit,t,object,patch,u,v,px,py,pz,nx,ny,nz";

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use crate::scene::LoadError;
-use crate::scene::write::write_atomic;
+use crate::io::OutputError;
+use crate::io::write_atomic;
 
 /// Rows of background between the image and the gradient strip.
 const GAP: u32 = 3;
@@ -83,7 +83,7 @@ pub fn heat_map(values: &[f32], width: u32, height: u32) -> HeatMap {
 
 impl HeatMap {
     /// Writes an 8-bit RGB PNG, atomically.
-    pub fn write_png(&self, path: &Path) -> Result<(), LoadError> {
+    pub fn write_png(&self, path: &Path) -> Result<(), OutputError> {
         write_atomic(path, |w| {
             use image::ImageEncoder;
             image::codecs::png::PngEncoder::new(w)

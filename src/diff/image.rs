@@ -6,8 +6,8 @@ use std::path::Path;
 
 use glam::Vec4;
 
+use crate::formats::LoadError;
 use crate::render::film::{Film, ImageFormat, linear_to_srgb8};
-use crate::scene::LoadError;
 
 /// How an image's values were stored, which decides the space its metrics are taken in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]

@@ -49,7 +49,7 @@ fn random_patch() -> impl Strategy<Value = BezierPatch> {
 
 fn teapot() -> Vec<BezierPatch> {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("testdata/teapot.bpt");
-    crate::scene::bpt::read_bpt(&path).unwrap()
+    crate::formats::bpt::read_bpt(&path).unwrap()
 }
 
 proptest! {

@@ -6,8 +6,8 @@ use std::path::Path;
 
 use glam::Vec4;
 
-use crate::scene::LoadError;
-use crate::scene::write::{temporary_name, write_atomic};
+use crate::io::OutputError;
+use crate::io::{temporary_name, write_atomic};
 
 pub struct Film {
     pub width: u32,
@@ -99,7 +99,7 @@ impl Film {
     }
 
     /// Writes by extension, atomically.
-    pub fn write(&self, path: &Path) -> Result<(), LoadError> {
+    pub fn write(&self, path: &Path) -> Result<(), OutputError> {
         match ImageFormat::of(path) {
             Some(ImageFormat::Png) => {
                 let bytes = self.to_srgb8();
@@ -116,14 +116,14 @@ impl Film {
                 })
             }
             Some(ImageFormat::Exr) => self.write_exr(path),
-            None => Err(LoadError::invalid(
+            None => Err(OutputError::invalid(
                 path,
                 "unsupported image type: expected .png or .exr",
             )),
         }
     }
 
-    fn write_exr(&self, path: &Path) -> Result<(), LoadError> {
+    fn write_exr(&self, path: &Path) -> Result<(), OutputError> {
         use exr::prelude::*;
         let (w, h) = (self.width as usize, self.height as usize);
         let tmp = temporary_name(path);
@@ -137,9 +137,9 @@ impl Film {
         );
         image.write().to_file(&tmp).map_err(|e| {
             let _ = std::fs::remove_file(&tmp);
-            LoadError::invalid(path, format!("writing EXR: {e}"))
+            OutputError::invalid(path, format!("writing EXR: {e}"))
         })?;
-        std::fs::rename(&tmp, path).map_err(|e| LoadError::io(path, e))
+        std::fs::rename(&tmp, path).map_err(|e| OutputError::io(path, e))
     }
 }
 
@@ -150,7 +150,7 @@ pub fn write_effort_png(
     width: u32,
     height: u32,
     effort: &[u32],
-) -> Result<std::path::PathBuf, LoadError> {
+) -> Result<std::path::PathBuf, OutputError> {
     let png_path = sibling(image_path, "effort", "png");
     let values: Vec<f32> = effort.iter().map(|&e| e as f32).collect();
     let max = values.iter().copied().fold(1.0f32, f32::max).ln_1p();

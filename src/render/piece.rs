@@ -19,8 +19,9 @@ use exr::prelude::{
 };
 
 use super::window::Window;
-use crate::scene::LoadError;
-use crate::scene::write::{temporary_name, write_atomic};
+use crate::formats::LoadError;
+use crate::io::OutputError;
+use crate::io::{temporary_name, write_atomic};
 
 /// EXR attribute and PNG keyword of the provenance.
 pub const PROVENANCE_KEY: &str = "patchtrace";
@@ -65,7 +66,7 @@ pub fn write_exr(
     path: &Path,
     info: &PieceInfo,
     channels: Vec<AnyChannel<FlatSamples>>,
-) -> Result<(), LoadError> {
+) -> Result<(), OutputError> {
     let w = info.window;
     let mut attributes = LayerAttributes {
         layer_position: Vec2(w.x0 as i32, w.y0 as i32),
@@ -86,13 +87,13 @@ pub fn write_exr(
     let tmp = temporary_name(path);
     image.write().to_file(&tmp).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
-        LoadError::invalid(path, format!("writing EXR: {e}"))
+        OutputError::invalid(path, format!("writing EXR: {e}"))
     })?;
-    std::fs::rename(&tmp, path).map_err(|e| LoadError::io(path, e))
+    std::fs::rename(&tmp, path).map_err(|e| OutputError::io(path, e))
 }
 
 /// Writes 8-bit sRGB RGBA pixels of `info.window` as PNG with the piece's text chunks.
-pub fn write_png(path: &Path, info: &PieceInfo, rgba8: &[u8]) -> Result<(), LoadError> {
+pub fn write_png(path: &Path, info: &PieceInfo, rgba8: &[u8]) -> Result<(), OutputError> {
     let w = info.window;
     write_atomic(path, |out| {
         let mut enc = png::Encoder::new(out, w.width(), w.height());

@@ -52,9 +52,8 @@ pub const ADAPTIVE_FIRST: u32 = 4;
 /// `--spp adaptive` without `:MAX` refines up to this many samples, the reference count
 /// of the antialiasing table in BENCHMARKS.md.
 pub const ADAPTIVE_DEFAULT_MAX: u32 = 64;
-/// The most samples per pixel `--spp` accepts: a 2^16 net, far beyond what a Whitted
-/// image needs, and small enough that a pixel's sum cannot lose a sample's weight in f32.
-pub const MAX_SPP: u32 = 1 << 16;
+/// The most samples per pixel `--spp` accepts ([`crate::scene::MAX_SAMPLES`]).
+pub const MAX_SPP: u32 = crate::scene::MAX_SAMPLES;
 
 impl std::str::FromStr for SampleCount {
     type Err = String;

@@ -24,7 +24,7 @@ pub struct BareShell {
     /// Name and material index of each object, in order.
     objects: Vec<(String, usize)>,
     /// The geometry's bounds, min and max: `--width`, `--height` and `--up` frame the
-    /// geometry again ([`crate::scene::load::reframe`]).
+    /// geometry again ([`crate::formats::load::reframe`]).
     bounds: [[f64; 3]; 2],
 }
 

@@ -145,7 +145,7 @@ impl Surface {
     }
 
     /// The region the trim loops keep, `None` without loops; an error for loops that cannot
-    /// be converted (the readers check this at load, [`crate::scene::check_trims`]).
+    /// be converted (the readers check this at load, [`crate::formats::check_trims`]).
     pub fn trim_region(&self) -> Result<Option<TrimRegion>, TrimError> {
         TrimRegion::new(&self.trims, &self.trim_space)
     }
@@ -436,6 +436,11 @@ mod axis_tests {
         assert!((Axis::Y.to_z_up() * DVec3::Z - -DVec3::Y).length() < 1e-15);
     }
 }
+
+/// The most samples per pixel a scene or `render --spp` may ask for: a 2^16 net, far
+/// beyond what a Whitted image needs, and small enough that a pixel's sum cannot lose a
+/// sample's weight in f32.
+pub const MAX_SAMPLES: u32 = 1 << 16;
 
 /// Everything needed to render.
 #[derive(Clone, Debug, PartialEq)]

@@ -12,9 +12,9 @@ use gltf_json as json;
 use json::validation::Checked::Valid;
 use json::validation::USize64;
 
-use crate::scene::error::LoadError;
+use crate::io::OutputError;
+use crate::io::write_atomic;
 use crate::scene::model::{Geometry, Scene, TriangleMesh};
-use crate::scene::write::write_atomic;
 
 /// Output formats of `tessellate`, by extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -39,9 +39,9 @@ impl MeshFormat {
 /// Writes every mesh object of `scene` (one OBJ object or glTF mesh and node each) in the
 /// format named by the extension, and returns the size of the written file in bytes.
 /// Objects that are still free-form surfaces are an error: tessellate them first.
-pub fn write_mesh_scene(path: &Path, scene: &Scene) -> Result<u64, LoadError> {
+pub fn write_mesh_scene(path: &Path, scene: &Scene) -> Result<u64, OutputError> {
     let format = MeshFormat::of(path).ok_or_else(|| {
-        LoadError::invalid(
+        OutputError::invalid(
             path,
             "unsupported mesh output: expected .obj, .gltf or .glb",
         )
@@ -51,7 +51,7 @@ pub fn write_mesh_scene(path: &Path, scene: &Scene) -> Result<u64, LoadError> {
         match &o.geometry {
             Geometry::Mesh(m) => meshes.push((o.name.as_str(), m)),
             Geometry::Surfaces(_) | Geometry::Subdivision(_) | Geometry::Instance(_) => {
-                return Err(LoadError::invalid(
+                return Err(OutputError::invalid(
                     path,
                     format!(
                         "object {:?} is not a triangle mesh; tessellate it first",
@@ -65,13 +65,13 @@ pub fn write_mesh_scene(path: &Path, scene: &Scene) -> Result<u64, LoadError> {
         MeshFormat::Obj => write_atomic(path, |w| write_obj(w, &meshes))?,
         MeshFormat::Gltf | MeshFormat::Glb => {
             let bytes = gltf_bytes(&meshes, format == MeshFormat::Glb)
-                .map_err(|m| LoadError::invalid(path, m))?;
+                .map_err(|m| OutputError::invalid(path, m))?;
             write_atomic(path, |w| w.write_all(&bytes))?;
         }
     }
     std::fs::metadata(path)
         .map(|m| m.len())
-        .map_err(|e| LoadError::io(path, e))
+        .map_err(|e| OutputError::io(path, e))
 }
 
 fn write_obj(w: &mut dyn Write, meshes: &[(&str, &TriangleMesh)]) -> std::io::Result<()> {

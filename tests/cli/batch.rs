@@ -346,7 +346,7 @@ fn an_up_y_object_stands_its_y_axis_along_z() {
         ),
     )
     .unwrap();
-    let loaded = patchtrace::scene::load_scene(&scene).unwrap();
+    let loaded = patchtrace::formats::load_scene(&scene).unwrap();
     let b = loaded.objects[0].bounds();
     let want_min = [lo[0], -hi[2], lo[1]];
     let want_max = [hi[0], -lo[2], hi[1]];

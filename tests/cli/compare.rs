@@ -105,7 +105,7 @@ fn tessellate_writes_each_format_and_reports_counts() {
             std::fs::metadata(&out).unwrap().len()
         );
         // The written mesh loads back as a scene with that many triangles.
-        let scene = patchtrace::scene::load_scene(&out).unwrap();
+        let scene = patchtrace::formats::load_scene(&out).unwrap();
         let tris: usize = scene
             .objects
             .iter()

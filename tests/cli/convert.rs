@@ -4,8 +4,9 @@
 use crate::common;
 
 use common::{run, stderr, stdout, testdata};
+use patchtrace::formats::load_geometry;
 use patchtrace::geom::BezierPatch;
-use patchtrace::scene::{Geometry, SurfaceGeometry, load_geometry};
+use patchtrace::scene::{Geometry, SurfaceGeometry};
 
 fn patches_of(path: &std::path::Path) -> Vec<BezierPatch> {
     match load_geometry(path).unwrap() {
@@ -102,7 +103,7 @@ fn import_convert_write_read_gives_the_same_patches() {
         // Decomposition straight from the source file, independent of the RON and OBJ
         // round trip.
         let direct = patches_of(&testdata(name));
-        let scene = patchtrace::scene::load_scene(&obj).unwrap();
+        let scene = patchtrace::formats::load_scene(&obj).unwrap();
         // RON keeps each Bézier patch's loops and domain.
         assert_eq!(scene.trim_loop_count() > 0, trimmed, "{name}");
         let back: Vec<BezierPatch> = scene

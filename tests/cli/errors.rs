@@ -222,8 +222,8 @@ fn bpt_round_trips_through_import() {
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let a = patchtrace::scene::bpt::read_bpt(&testdata("teapot.bpt")).unwrap();
-    let b = patchtrace::scene::bpt::read_bpt(&out).unwrap();
+    let a = patchtrace::formats::bpt::read_bpt(&testdata("teapot.bpt")).unwrap();
+    let b = patchtrace::formats::bpt::read_bpt(&out).unwrap();
     assert_eq!(a, b);
 }
 
@@ -238,8 +238,8 @@ fn ron_round_trips_through_import() {
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let a = patchtrace::scene::load_scene(&testdata("teapot.ron")).unwrap();
-    let b = patchtrace::scene::load_scene(&out).unwrap();
+    let a = patchtrace::formats::load_scene(&testdata("teapot.ron")).unwrap();
+    let b = patchtrace::formats::load_scene(&out).unwrap();
     assert_eq!(a.camera, b.camera);
     assert_eq!(a.lights, b.lights);
     assert_eq!(a.objects.len(), b.objects.len());

@@ -2,10 +2,10 @@
 
 use std::process::Command;
 
+use patchtrace::formats::obj::parse_obj_freeform;
 use patchtrace::geom::BezierPatch;
 use patchtrace::geom::bezier::ParamRect;
 use patchtrace::scene::SurfaceGeometry;
-use patchtrace::scene::obj::parse_obj_freeform;
 
 fn patchtrace() -> Command {
     Command::new(env!("CARGO_BIN_EXE_patchtrace"))

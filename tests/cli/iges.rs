@@ -86,8 +86,8 @@ fn import_to_ron_keeps_trims_and_trim_spaces() {
             out.to_str().unwrap(),
         ]);
         assert!(o.status.success(), "{}", stderr(&o));
-        let a = patchtrace::scene::load_scene(&input).unwrap();
-        let b = patchtrace::scene::load_scene(&out).unwrap();
+        let a = patchtrace::formats::load_scene(&input).unwrap();
+        let b = patchtrace::formats::load_scene(&out).unwrap();
         let surfaces = |s: &patchtrace::scene::Scene| -> Vec<patchtrace::scene::Surface> {
             s.objects
                 .iter()
@@ -107,7 +107,7 @@ fn import_to_ron_keeps_trims_and_trim_spaces() {
         assert_eq!(sa, sb, "{}", input.display());
     }
     // The fuzz sample holds a surface of revolution: its angle map must survive too.
-    let a = patchtrace::scene::load_scene(&testdata("trimmed_patch.igs")).unwrap();
+    let a = patchtrace::formats::load_scene(&testdata("trimmed_patch.igs")).unwrap();
     let arcs = a.objects.iter().any(|o| match &o.geometry {
         patchtrace::scene::Geometry::Surfaces(s) => s
             .iter()

@@ -9,10 +9,11 @@ use std::sync::Arc;
 
 use glam::DVec3;
 use patchtrace::accel::scene::{Precision, QueryStats, SceneGeometry, SceneHit};
+use patchtrace::formats::load_scene;
 use patchtrace::geom::{DAabb, Ray};
 use patchtrace::kernel::subdivision::SubdivisionConfig;
 use patchtrace::scene::generate::{SplitMix64, TEAPOT_BPT, TeapotsSpec, teapots_scene};
-use patchtrace::scene::{Geometry, Scene, load_scene};
+use patchtrace::scene::{Geometry, Scene};
 
 /// The generated teapot scene written into `dir`, instanced or flattened.
 fn teapots(dir: &Path, count: usize, flatten: bool) -> std::path::PathBuf {

@@ -9,9 +9,10 @@ use std::process::Command;
 use common::{run, stderr, testdata};
 use patchtrace::accel::bvh::Bvh;
 use patchtrace::accel::scene::SceneGeometry;
+use patchtrace::formats::load_scene;
 use patchtrace::geom::Aabb;
 use patchtrace::progress::ProgressBar;
-use patchtrace::scene::{Geometry, load_scene};
+use patchtrace::scene::Geometry;
 
 #[test]
 fn bvh_builds_count_every_primitive_once_per_phase() {
@@ -36,7 +37,7 @@ fn bvh_builds_count_every_primitive_once_per_phase() {
             _ => 0,
         })
         .sum();
-    let teapot = patchtrace::scene::bpt::read_bpt(&testdata("teapot.bpt")).unwrap();
+    let teapot = patchtrace::formats::bpt::read_bpt(&testdata("teapot.bpt")).unwrap();
     assert_eq!(patches, teapot.len() + 1);
     let bar = ProgressBar::hidden();
     SceneGeometry::build_with(&scene, &bar);

@@ -7,6 +7,8 @@ use crate::common;
 
 use glam::DVec3;
 use patchtrace::bench::accuracy::{self, Method, MethodResult};
+use patchtrace::formats::load_scene;
+use patchtrace::formats::rays::RayQuery;
 use patchtrace::geom::{BezierPatch, Ray};
 use patchtrace::kernel::KernelStats;
 use patchtrace::kernel::subdivision::{
@@ -14,8 +16,7 @@ use patchtrace::kernel::subdivision::{
 };
 use patchtrace::progress::ProgressBar;
 use patchtrace::render::camera::CameraRays;
-use patchtrace::scene::rays::RayQuery;
-use patchtrace::scene::{Scene, load_scene};
+use patchtrace::scene::Scene;
 
 use common::testdata;
 

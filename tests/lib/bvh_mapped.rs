@@ -16,10 +16,10 @@ use glam::Vec3;
 use patchtrace::accel::bvh::{Bvh, checksum};
 use patchtrace::accel::mapped;
 use patchtrace::accel::scene::{FromFile, Precision, QueryStats, SceneGeometry};
+use patchtrace::formats::ron_format::parsed_scene;
+use patchtrace::formats::{LoadOptions, load_scene_keyed};
 use patchtrace::geom::{Aabb, Ray};
 use patchtrace::kernel::subdivision::SubdivisionConfig;
-use patchtrace::scene::ron_format::parsed_scene;
-use patchtrace::scene::{LoadOptions, load_scene_keyed};
 
 /// Three teapots from one `.bpt` file, each placed by its own transform (so 96 distinct
 /// patches in world space), and a bilinear floor written inline.

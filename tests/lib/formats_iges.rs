@@ -8,9 +8,9 @@ use std::f64::consts::PI;
 use std::path::Path;
 
 use glam::{DQuat, DVec2, DVec3};
+use patchtrace::formats::cad::iges::{Iges, parse_iges};
 use patchtrace::geom::nurbs::NurbsSurface;
 use patchtrace::geom::trim::{ParamCurve, TrimLoop};
-use patchtrace::scene::iges::{Iges, parse_iges};
 use patchtrace::scene::model::{Surface, SurfaceGeometry};
 
 use crate::iges_support;
@@ -561,7 +561,7 @@ fn external(name: &str) -> std::path::PathBuf {
 
 #[test]
 fn torus_igs_loads_one_closed_bicubic() {
-    let read = patchtrace::scene::iges::read_iges(&external("torus.igs")).unwrap();
+    let read = patchtrace::formats::cad::iges::read_iges(&external("torus.igs")).unwrap();
     let (n, s) = only(&read);
     assert_eq!(
         (n.degree_u, n.degree_v, n.count_u, n.count_v),
@@ -573,8 +573,8 @@ fn torus_igs_loads_one_closed_bicubic() {
 
 #[test]
 fn hammer_from_iges_is_the_hammer_from_obj() {
-    let iges = patchtrace::scene::load_geometry(&external("hammer.iges")).unwrap();
-    let obj = patchtrace::scene::load_geometry(&external("hammer.from_iges.obj")).unwrap();
+    let iges = patchtrace::formats::load_geometry(&external("hammer.iges")).unwrap();
+    let obj = patchtrace::formats::load_geometry(&external("hammer.from_iges.obj")).unwrap();
     let (patchtrace::scene::Geometry::Surfaces(a), patchtrace::scene::Geometry::Surfaces(b)) =
         (iges, obj)
     else {

@@ -3,9 +3,9 @@
 use std::path::{Path, PathBuf};
 
 use glam::DVec3;
+use patchtrace::formats::gltf_mesh::read_gltf;
+use patchtrace::formats::mesh::read_obj_mesh;
 use patchtrace::scene::TriangleMesh;
-use patchtrace::scene::gltf_mesh::read_gltf;
-use patchtrace::scene::mesh::read_obj_mesh;
 
 fn testdata(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -4,11 +4,12 @@
 use std::path::Path;
 
 use glam::{DVec3, DVec4};
+use patchtrace::formats::ParseError;
+use patchtrace::formats::obj::{is_freeform, parse_obj_freeform, write_obj_freeform};
 use patchtrace::geom::BezierPatch;
 use patchtrace::geom::bezier::ParamRect;
 use patchtrace::geom::nurbs::NurbsSurface;
-use patchtrace::scene::obj::{is_freeform, parse_obj_freeform, write_obj_freeform};
-use patchtrace::scene::{ParseError, Surface, SurfaceGeometry};
+use patchtrace::scene::{Surface, SurfaceGeometry};
 use proptest::prelude::*;
 
 fn read(name: &str) -> Vec<Surface> {
@@ -494,7 +495,7 @@ fn surf_range_restricts_the_surface_exactly() {
     let src = "v 0 0 0\nv 4 0 0\nv 0 2 0\nv 4 2 1\ncstype bspline\ndeg 1 1\nsurf 1 3 0 2.5 1 2 3 4\nparm u 0 0 4 4\nparm v 0 0 2 2\nend\n\
         v 0 0 5\nv 1 0 5\nv 2 0 5\nv 0 1 5\nv 1 1 5\nv 2 1 6\ncstype bezier\ndeg 1 1\nsurf 0.5 1.5 0 1 5 6 7 8 9 10\nparm u 0 1 2\nparm v 0 1\nend\n";
     let surfaces =
-        patchtrace::scene::obj::parse_obj_freeform(std::path::Path::new("range.obj"), src)
+        patchtrace::formats::obj::parse_obj_freeform(std::path::Path::new("range.obj"), src)
             .expect("parses");
     let patchtrace::scene::SurfaceGeometry::Nurbs(n) = &surfaces[0].geometry else {
         panic!("a B-spline surface");

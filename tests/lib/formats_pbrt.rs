@@ -3,9 +3,10 @@
 use std::path::Path;
 
 use glam::{DVec3, DVec4};
+use patchtrace::formats::ParseError;
+use patchtrace::formats::pbrt::parse_pbrt;
 use patchtrace::geom::nurbs::NurbsSurface;
-use patchtrace::scene::pbrt::parse_pbrt;
-use patchtrace::scene::{ParseError, Surface, SurfaceGeometry};
+use patchtrace::scene::{Surface, SurfaceGeometry};
 
 fn nurbs(s: &Surface) -> &NurbsSurface {
     match &s.geometry {

@@ -7,12 +7,13 @@ use std::collections::{HashMap, HashSet};
 use glam::{DVec3, Vec3};
 use patchtrace::accel::grid::{DEFAULT_BUDGET_BYTES, Grid};
 use patchtrace::accel::scene::{Precision, QueryStats, SceneGeometry};
+use patchtrace::formats::load_scene;
 use patchtrace::geom::ulp::ulp_distance;
 use patchtrace::geom::{BezierPatch, DAabb, Ray};
 use patchtrace::kernel::subdivision::SubdivisionConfig;
 use patchtrace::kernel::triangle::{RayShear, intersect_triangle};
+use patchtrace::scene::Scene;
 use patchtrace::scene::generate::{SplitMix64, TEAPOT_BPT, TeapotsSpec, teapots_scene};
-use patchtrace::scene::{Scene, load_scene};
 
 /// Largest ulp distance between the `t` of two different patches that both hit a ray
 /// at a shared edge: both kernels report the entry of a final box, and final boxes stop

@@ -9,13 +9,13 @@ use std::path::Path;
 
 use glam::{DAffine3, DVec3};
 use kernel_common::Rng;
+use patchtrace::formats::bpt::read_bpt;
 use patchtrace::geom::{Aabb, BezierPatch, Ray};
 use patchtrace::kernel::secondary::{DEFAULT_ULPS, secondary_origin};
 use patchtrace::kernel::subdivision::{
     PreparedPatch, SubdivisionConfig, intersect, occluded, widen_by_net_rounding,
 };
 use patchtrace::kernel::{KernelStats, PatchHit};
-use patchtrace::scene::bpt::read_bpt;
 
 fn teapot() -> Vec<BezierPatch> {
     read_bpt(

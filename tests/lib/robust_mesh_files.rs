@@ -19,9 +19,9 @@ use proptest::test_runner::{Config, TestRunner};
 use serde_json::Value;
 
 use patchtrace::accel::bvh::{Bvh, checksum};
+use patchtrace::formats::LoadError;
+use patchtrace::formats::gltf_mesh::read_gltf;
 use patchtrace::geom::{Aabb, Ray};
-use patchtrace::scene::LoadError;
-use patchtrace::scene::gltf_mesh::read_gltf;
 
 fn cases() -> u32 {
     std::env::var("PATCHTRACE_FUZZ_CASES")

@@ -10,7 +10,8 @@ use std::path::{Path, PathBuf};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 
-use patchtrace::scene::{ParseError, bpt, iges, obj, pbrt, rays, ron_format, step};
+use patchtrace::formats::cad::{iges, step};
+use patchtrace::formats::{ParseError, bpt, obj, pbrt, rays, ron_format};
 
 use crate::mutate;
 use crate::step_support;

@@ -10,10 +10,10 @@ use std::f64::consts::{PI, TAU};
 use std::path::Path;
 
 use glam::{DQuat, DVec2, DVec3, DVec4};
+use patchtrace::formats::cad::step::{StepModel, read_step_str};
 use patchtrace::geom::nurbs::NurbsCurve;
 use patchtrace::geom::trim::TrimLoop;
 use patchtrace::scene::model::{Geometry, Surface, SurfaceGeometry};
-use patchtrace::scene::step::{StepModel, read_step_str};
 use step_support::{StepWriter, basis, expand};
 
 fn read(text: &str) -> StepModel {

@@ -5,8 +5,8 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use glam::DVec3;
+use patchtrace::formats::bpt::read_bpt;
 use patchtrace::geom::BezierPatch;
-use patchtrace::scene::bpt::read_bpt;
 use patchtrace::tessellate::{PatchMesh, TessellationMode, grid_for_triangles, tessellate_patches};
 
 fn teapot() -> Vec<BezierPatch> {

@@ -9,9 +9,10 @@ use std::path::Path;
 
 use glam::{DVec2, DVec3};
 use patchtrace::accel::scene::{Precision, QueryStats, SceneGeometry};
+use patchtrace::formats::load_scene;
 use patchtrace::geom::Ray;
 use patchtrace::geom::trim::{ParamCurve, TrimLoop};
-use patchtrace::scene::{Geometry, SurfaceGeometry, load_scene};
+use patchtrace::scene::{Geometry, SurfaceGeometry};
 
 const HAMMER: &str = "testdata/gismo/hammer.from_iges.obj";
 

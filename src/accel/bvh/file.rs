@@ -80,7 +80,7 @@ pub fn checksum(bytes: &[u8]) -> u64 {
 
 impl Bvh {
     /// Writes the tree section for inputs with key `key`. Atomic replacement of a file on
-    /// disk is the caller's job (`scene::write::write_atomic`).
+    /// disk is the caller's job (`io::write_atomic`).
     pub fn write(&self, w: &mut dyn Write, key: u64) -> io::Result<()> {
         w.write_all(&self.section(key))
     }

@@ -15,13 +15,13 @@ use glam::DVec3;
 use serde::Serialize;
 
 use crate::accel::scene::{Precision, QueryStats, SceneGeometry, SceneHit};
+use crate::formats::rays::RayQuery;
 use crate::geom::{DAabb, Ray};
 use crate::kernel::cached::CachedConfig;
 use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig, Termination};
 use crate::kernel::toth::TothConfig;
 use crate::progress::ProgressBar;
 use crate::render::camera::CameraRays;
-use crate::scene::rays::RayQuery;
 use crate::scene::{Camera, Scene};
 use crate::tessellate::{TessellationMode, TessellationReport, tessellate_scene};
 

@@ -13,6 +13,9 @@ use indicatif::ProgressBar;
 
 use crate::accel::grid::DEFAULT_BUDGET_BYTES;
 use crate::accel::scene::{Precision, SceneGeometry};
+use crate::formats::{LoadError, load_scene};
+use crate::io::OutputError;
+use crate::io::write_atomic;
 use crate::kernel::cached::{CachedConfig, DEFAULT_MAX_DEPTH};
 use crate::kernel::secondary::DEFAULT_ULPS;
 use crate::kernel::toth::TothConfig;
@@ -22,8 +25,6 @@ use crate::render::plan::EffectPlan;
 use crate::render::renderer::render_image_in_order;
 use crate::render::stats::RayReport;
 use crate::scene::generate::{TEAPOT_BPT, TeapotsSpec, teapots_scene};
-use crate::scene::write::write_atomic;
-use crate::scene::{LoadError, load_scene};
 use paper::PaperTable;
 
 /// Seed of every generated test scene: test cases 2–4 are "the same environment" (§7.2),
@@ -205,8 +206,8 @@ pub struct CaseResult {
 }
 
 /// Writes the generated scene of `case` at `size`² into `dir`, returning its path.
-pub fn write_case_scene(case: &Case, size: u32, dir: &Path) -> Result<PathBuf, LoadError> {
-    std::fs::create_dir_all(dir).map_err(|e| LoadError::io(dir, e))?;
+pub fn write_case_scene(case: &Case, size: u32, dir: &Path) -> Result<PathBuf, OutputError> {
+    std::fs::create_dir_all(dir).map_err(|e| OutputError::io(dir, e))?;
     let bpt = dir.join("teapot.bpt");
     write_atomic(&bpt, |w| w.write_all(TEAPOT_BPT.as_bytes()))?;
     let spec = TeapotsSpec {
@@ -224,9 +225,18 @@ pub fn write_case_scene(case: &Case, size: u32, dir: &Path) -> Result<PathBuf, L
     Ok(path)
 }
 
+/// Writing a case's scene or reading it back failed.
+#[derive(Debug, thiserror::Error)]
+pub enum CaseError {
+    #[error(transparent)]
+    Write(#[from] OutputError),
+    #[error(transparent)]
+    Load(#[from] LoadError),
+}
+
 /// Renders every selected case with every selected method on the current rayon pool.
 /// `progress` advances once per render.
-pub fn run(config: &Config, progress: &ProgressBar) -> Result<Vec<CaseResult>, LoadError> {
+pub fn run(config: &Config, progress: &ProgressBar) -> Result<Vec<CaseResult>, CaseError> {
     progress.set_length((config.cases.len() * config.methods.len()) as u64);
     let mut results = Vec::new();
     for case in CASES.iter().filter(|c| config.cases.contains(&c.number)) {

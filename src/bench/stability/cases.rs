@@ -9,11 +9,11 @@ use std::path::Path;
 
 use glam::{DAffine3, DQuat, DVec2, DVec3, Vec3};
 
+use crate::formats::bpt::parse_bpt;
 use crate::geom::nurbs::shapes::sphere;
 use crate::geom::trim::{ParamCurve, TrimLoop};
 use crate::geom::ulp::step_ulps;
 use crate::geom::{BezierPatch, Ray};
-use crate::scene::bpt::parse_bpt;
 use crate::scene::generate::{SplitMix64, TEAPOT_BPT};
 use crate::scene::{Geometry, Instance, Material, Object, Scene, Surface};
 

@@ -29,6 +29,7 @@ use indicatif::ProgressBar;
 
 use super::cases::Case;
 use crate::accel::scene::{Precision, QueryStats, SceneGeometry, SceneHit};
+use crate::formats::load::check_f32_range;
 use crate::geom::ulp::ulp_of;
 use crate::geom::{Aabb, BezierPatch, DAabb, Ray};
 use crate::kernel::secondary::{DEFAULT_ULPS, secondary_origin};
@@ -37,7 +38,6 @@ use crate::render::integrator::{Integrator, TraceSettings};
 use crate::render::plan::EffectPlan;
 use crate::render::renderer::render_image;
 use crate::scene::generate::SplitMix64;
-use crate::scene::load::check_f32_range;
 
 /// Slack, in ulps of the hit's largest coordinate, allowed beyond the final boxes when
 /// comparing hits: the `f32` kernel's final box is decided by rounding of its own corners

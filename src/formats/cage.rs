@@ -8,9 +8,9 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::error::{LoadError, ParseError, read_text};
-use super::model::TriangleMesh;
 use super::text::{Words, logical_lines};
 use crate::geom::subdiv::SubdivisionSurface;
+use crate::scene::model::TriangleMesh;
 
 /// Reads an OBJ file's polygons as a cage. Statements other than `v` and `f` (normals,
 /// texture coordinates, groups, materials, smoothing) do not shape the surface and are

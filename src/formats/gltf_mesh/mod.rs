@@ -29,7 +29,7 @@ use gltf_json::validation::Checked;
 
 use super::error::{BinaryError, LoadError, ParseError};
 use super::mesh::{append, finish};
-use super::model::TriangleMesh;
+use crate::scene::model::TriangleMesh;
 use data::Located;
 
 /// Most triangles a glTF scene may expand to (nodes can instance one mesh many times):

@@ -16,7 +16,7 @@ use glam::DAffine3;
 
 use super::entities::{Rec, Resolver};
 use super::records::Value;
-use crate::scene::error::ParseError;
+use crate::formats::error::ParseError;
 
 /// Deepest assembly nesting followed; deeper (or cyclic) structure is refused.
 const MAX_NESTING: usize = 32;

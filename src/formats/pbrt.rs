@@ -21,9 +21,9 @@ use std::path::Path;
 use glam::{DAffine3, DMat4, DVec3, DVec4};
 
 use super::error::ParseError;
-use super::model::{Surface, SurfaceGeometry};
 use crate::geom::MAX_DEGREE;
 use crate::geom::nurbs::NurbsSurface;
+use crate::scene::model::{Surface, SurfaceGeometry};
 
 /// Parses the NURBS shapes of a pbrt-v3 file; `path` is used in error messages only.
 pub fn parse_pbrt(path: &Path, src: &str) -> Result<Vec<Surface>, ParseError> {

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use super::records::Record;
-use crate::scene::error::ParseError;
+use crate::formats::error::ParseError;
 
 /// How an entity depends on others (status digits 3–4, §2.3.1 field 9).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -32,7 +32,7 @@ use rayon::prelude::*;
 use self::entities::Resolver;
 use self::style::Colour;
 use self::units::Units;
-use crate::scene::error::{LoadError, ParseError};
+use crate::formats::error::{LoadError, ParseError};
 use crate::scene::model::{Geometry, Instance, Material, Object, Surface};
 
 /// What reading a STEP file found beyond the geometry.

@@ -147,14 +147,14 @@ impl<R: std::io::BufRead> RayChunks<R> {
     }
 
     /// The next up to `max` rays, empty at the end of the file.
-    pub fn next_chunk(&mut self, max: usize) -> Result<Vec<RayQuery>, super::LoadError> {
+    pub fn next_chunk(&mut self, max: usize) -> Result<Vec<RayQuery>, super::error::LoadError> {
         let mut out = Vec::with_capacity(max.min(1 << 16));
         while out.len() < max {
             self.buf.clear();
             let n = self
                 .reader
                 .read_until(b'\n', &mut self.buf)
-                .map_err(|e| super::LoadError::io(&self.path, e))?;
+                .map_err(|e| super::error::LoadError::io(&self.path, e))?;
             if n == 0 {
                 break;
             }

@@ -12,9 +12,9 @@ use std::sync::Arc;
 use glam::{DVec3, DVec4};
 
 use super::records::{Exchange, Instance, Param, Record, Value};
+use crate::formats::error::ParseError;
 pub use crate::geom::nurbs::analytic::Frame;
 use crate::geom::nurbs::{NurbsCurve, NurbsSurface};
-use crate::scene::error::ParseError;
 
 /// Longest chain of references followed while resolving one entity. Real B-reps are about
 /// ten deep (face → loop → edge → curve → placement → direction); a cycle in a damaged

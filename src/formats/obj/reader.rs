@@ -20,13 +20,13 @@ use std::path::Path;
 
 use glam::{DVec3, DVec4};
 
+use crate::formats::error::ParseError;
+use crate::formats::text::{Token, Words, logical_lines};
 use crate::geom::MAX_DEGREE;
 use crate::geom::bezier::{BezierPatch, ParamRect};
 use crate::geom::nurbs::NurbsSurface;
 use crate::geom::trim::{ParamCurve, TrimLoop, TrimSegment};
-use crate::scene::error::ParseError;
 use crate::scene::model::{Surface, SurfaceGeometry};
-use crate::scene::text::{Token, Words, logical_lines};
 
 /// Parses the free-form surfaces of an OBJ text; `path` is used in error messages only.
 pub fn parse_obj_freeform(path: &Path, src: &str) -> Result<Vec<Surface>, ParseError> {

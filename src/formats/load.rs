@@ -2,11 +2,12 @@
 
 use std::path::Path;
 
+use super::cad::{iges, step};
 use super::error::LoadError;
-use super::model::Material;
-use super::model::{Axis, Geometry, Object, Scene, Surface};
-use super::{bpt, cage, gltf_mesh, iges, mesh, obj, pbrt, ron_format, step};
+use super::{bpt, cage, gltf_mesh, mesh, obj, pbrt, ron_format};
 use crate::geom::bbox::DAabb;
+use crate::scene::model::Material;
+use crate::scene::model::{Axis, Geometry, Object, Scene, Surface};
 
 /// The kinds of input file we read, by extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -161,7 +162,7 @@ pub fn load_scene_with(path: &Path, options: LoadOptions) -> Result<Scene, LoadE
 /// hashed but not parsed, and the objects they feed get no geometry: for a caller that
 /// finds it prepared in a BVH file with this key. Bare geometry is keyed by its bytes and
 /// `options`, and read unless `defer` and `parsed` holds the shell of its scene for the
-/// same key ([`BareShell`](super::bare_shell::BareShell)): its default camera frames the
+/// same key ([`BareShell`](crate::scene::bare_shell::BareShell)): its default camera frames the
 /// geometry, so only a kept shell stands in for it. `parsed` is what a BVH file keeps: a RON scene's
 /// [`ron_format::parsed_scene`] or a bare file's shell.
 pub fn load_scene_keyed(
@@ -185,7 +186,7 @@ pub fn load_scene_keyed(
     let key = key.finish();
     let kept = parsed
         .filter(|(hash, _)| defer && *hash == key)
-        .and_then(|(_, json)| super::bare_shell::BareShell::scene_of(json));
+        .and_then(|(_, json)| crate::scene::bare_shell::BareShell::scene_of(json));
     let scene = match kept {
         Some(scene) => scene,
         None => load_scene_with(path, options)?,
@@ -341,7 +342,7 @@ fn iges_scene(path: &Path) -> Result<Scene, LoadError> {
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     let mut colours: Vec<Option<glam::DVec3>> = Vec::new();
-    let mut groups: Vec<Vec<super::model::Surface>> = Vec::new();
+    let mut groups: Vec<Vec<crate::scene::model::Surface>> = Vec::new();
     for d in read.surfaces {
         let k = match colours.iter().position(|c| *c == d.colour) {
             Some(k) => k,

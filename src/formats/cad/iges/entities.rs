@@ -9,7 +9,7 @@ use glam::{DAffine3, DMat3, DVec2, DVec3};
 
 use super::directory::DirEntry;
 use super::records::{Token, Value};
-use crate::scene::error::ParseError;
+use crate::formats::error::ParseError;
 
 /// One entity's parameters, with what is needed to locate an error in them.
 pub struct Params<'a> {

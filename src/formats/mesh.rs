@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use super::error::LoadError;
-use super::model::TriangleMesh;
+use crate::scene::model::TriangleMesh;
 
 /// Reads a polygonal OBJ file as one mesh (all objects and groups merged), triangulating
 /// faces ([`super::obj::parse_obj_mesh`]). Normals are kept when every vertex has one.

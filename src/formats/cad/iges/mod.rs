@@ -30,7 +30,7 @@ use glam::{DAffine3, DVec3};
 use self::directory::DirEntry;
 use self::entities::{Entity, Params};
 use self::records::Value;
-use crate::scene::error::ParseError;
+use crate::formats::error::ParseError;
 use crate::scene::model::Surface;
 
 /// The file's entities, addressed by directory pointer.
@@ -491,8 +491,8 @@ fn draw(
 }
 
 /// Reads an IGES file from disk.
-pub fn read_iges(path: &Path) -> Result<Iges, crate::scene::LoadError> {
+pub fn read_iges(path: &Path) -> Result<Iges, crate::formats::LoadError> {
     // Hollerith strings may hold any 8-bit text; the geometry is ASCII.
-    let bytes = std::fs::read(path).map_err(|e| crate::scene::LoadError::io(path, e))?;
+    let bytes = std::fs::read(path).map_err(|e| crate::formats::LoadError::io(path, e))?;
     Ok(parse_iges(path, &String::from_utf8_lossy(&bytes))?)
 }

@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use crate::scene::error::ParseError;
+use crate::formats::error::ParseError;
 
 /// Columns 1–72 hold data, column 73 the section letter (§2.1.1).
 const DATA_COLUMNS: usize = 72;

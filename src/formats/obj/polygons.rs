@@ -13,8 +13,8 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::super::error::ParseError;
-use super::super::model::TriangleMesh;
 use super::super::text::{LogicalLine, Token, Words, logical_lines};
+use crate::scene::model::TriangleMesh;
 
 /// Parses a polygonal OBJ text with at least one face.
 pub fn parse_obj_mesh(path: &Path, src: &str) -> Result<TriangleMesh, ParseError> {

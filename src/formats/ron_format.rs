@@ -8,15 +8,15 @@ use std::sync::Arc;
 use glam::{DAffine3, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
-use super::animation::{CameraKey, CameraPath};
 use super::error::{LoadError, ParseError};
-use super::model::*;
 use super::ron_locate::RonLocator;
 use super::source_key::SourceKey;
 use crate::geom::BezierPatch;
 use crate::geom::bezier::ParamRect;
 use crate::geom::nurbs::NurbsSurface;
 use crate::geom::trim::{AxisMap, ParamCurve, TrimLoop, TrimSegment};
+use crate::scene::animation::{CameraKey, CameraPath};
+use crate::scene::model::*;
 use xxhash_rust::xxh3::xxh3_64;
 
 type V3 = (f64, f64, f64);
@@ -353,7 +353,7 @@ fn build_scene(
     };
     validate_camera(&camera).map_err(|m| at.at_key("camera", m))?;
     let animation = camera_path(at, c, &camera)?;
-    let max_spp = crate::render::sampler::MAX_SPP;
+    let max_spp = MAX_SAMPLES;
     if let Some(n) = file.samples
         && !(1..=max_spp).contains(&n)
     {

@@ -1,0 +1,34 @@
+//! Readers and writers of every file format, apart from the scene model they produce
+//! ([`crate::scene`]): our RON scene, `.bpt` Bézier patch files, Wavefront OBJ (free-form
+//! surfaces with trims, and polygon meshes or Catmull–Clark cages), pbrt-v3
+//! `Shape "nurbs"`, glTF and GLB meshes, `trace` ray files, and the CAD exchange formats
+//! IGES and STEP ([`cad`]). Every reader reports errors as `file:line:col: what was
+//! expected` (or the byte offset, record or entity of a binary or CAD file); every writer
+//! writes to a temporary name and renames ([`crate::io`]).
+//!
+//! - [`load`]: choosing a reader by file type, bare geometry as a framed scene, and the
+//!   checks every loaded scene passes (coordinates within `f32`, trim loops usable).
+//! - [`error`]: located parse errors and load errors.
+//! - [`text`]: the tokenizer the line-based text formats share.
+//! - [`source_key`]: the digest of a scene's input files that a BVH file is checked against.
+
+pub mod bpt;
+pub mod cad;
+pub mod cage;
+pub mod error;
+pub mod gltf_mesh;
+pub mod load;
+pub mod mesh;
+pub mod obj;
+pub mod pbrt;
+pub mod rays;
+pub mod ron_format;
+pub mod ron_locate;
+pub mod source_key;
+pub mod text;
+pub mod write;
+
+pub use error::{LoadError, ParseError};
+pub use load::{
+    LoadOptions, load_geometry, load_scene, load_scene_keyed, load_scene_with, load_subdivision,
+};
