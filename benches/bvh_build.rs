@@ -1,4 +1,4 @@
-//! Issue 19, big unique scenes: the BVH build and the `render --bvh` load on 10,000
+//! big unique scenes: the BVH build and the `render --bvh` load on 10,000
 //! flattened teapots (`scene teapots --count 10000 --flatten`: 320,000 distinct patches),
 //! in wall and process CPU seconds (all threads; from /proc/self/stat, 10 ms ticks), three
 //! interleaved rounds, so that other work on the machine shows as wall time above CPU time.

@@ -1,5 +1,5 @@
-//! IGES reading speed (issue 16): a large file made at bench time by repeating the
-//! hammer's entities (`../shared/testdata/external/gismo/hammer.iges`, 45 trimmed
+//! IGES reading speed: a large file made at bench time by repeating the
+//! hammer's entities (`testdata/gismo/hammer.iges`, 45 trimmed
 //! surfaces over 128s, 1.0 MB) `COPIES` times with their pointers shifted, written to a
 //! temporary file and read by `read_iges` (file read, syntax, entities, conversion, trims).
 //! Target: a ~4 MB file with ~300 trimmed surfaces in under 0.5 s. Median of several
@@ -12,7 +12,8 @@ use std::time::Instant;
 
 use patchtrace::scene::iges::{directory, read_iges, records};
 
-#[path = "../tests/iges_support/mod.rs"]
+#[allow(dead_code)] // benches use a part of the test helpers
+#[path = "../tests/lib/iges_support/mod.rs"]
 mod iges_support;
 use iges_support::{Entry, fixed_format};
 #[path = "support/mod.rs"]
@@ -86,9 +87,8 @@ fn repeated(src: &str, copies: usize) -> String {
 }
 
 fn main() {
-    let hammer =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/testdata/external/gismo/hammer.iges");
-    let src = std::fs::read_to_string(&hammer).expect("the hammer (shared testdata)");
+    let hammer = Path::new(env!("CARGO_MANIFEST_DIR")).join("testdata/gismo/hammer.iges");
+    let src = std::fs::read_to_string(&hammer).expect("the hammer (testdata/gismo)");
     let dir = tempfile::tempdir().unwrap();
     for copies in [4, 7] {
         let text = repeated(&src, copies);

@@ -1,4 +1,4 @@
-//! Reading speed of the STEP reader (issue 17: a 5 MB file loads in under 1 s): the test
+//! Reading speed of the STEP reader (a 5 MB file loads in under 1 s): the test
 //! part of `tests/step_support` (8 faces: planes, a toroidal fillet, a cylinder with a
 //! pcurve seam, a B-spline bottom with a hole) repeated side by side until the file
 //! reaches 5 MB, written to a temporary file at bench time (not committed), then read
@@ -8,7 +8,8 @@
 //!
 //! `cargo bench --bench step_read`
 
-#[path = "../tests/step_support/mod.rs"]
+#[allow(dead_code)] // benches use a part of the test helpers
+#[path = "../tests/lib/step_support/mod.rs"]
 mod step_support;
 #[path = "support/mod.rs"]
 mod support;

@@ -1,4 +1,4 @@
-//! Catmull–Clark cages against their Bézier patches (issue 20's speed item): OpenSubdiv's
+//! Catmull–Clark cages against their Bézier patches (speed item): OpenSubdiv's
 //! `catmark_torus` (all regular) as a cage, the same surface as the Bézier patches
 //! `patchtrace import torus.obj --subdivide catmull-clark -o torus_bez.bpt` writes (written
 //! and read back here the same way), and `catmark_cube` (every quad at a valence-3 vertex,

@@ -1,5 +1,5 @@
 //! How `render` scales with threads on this machine, against the machine's own ceiling
-//! (issue 19, item 5). The ceiling is a trivially parallel loop: independent items of pure
+//!. The ceiling is a trivially parallel loop: independent items of pure
 //! arithmetic, no memory traffic, no shared state, split over a rayon pool of N threads;
 //! its speed-up over one thread is the most any program can get here (two cores that are
 //! hyper-threads of one, or a noisy neighbour, show up as a ceiling below N). Then the

@@ -13,7 +13,7 @@ use indicatif::ProgressStyle;
 
 /// Files at least this large get a spinner while they are read. Smaller ones read in well
 /// under a quarter of a second (the IGES bench reads 7.27 MB in 0.235 s in the dev
-/// profile, BENCHMARKS.md issue 16), where a spinner would only flash.
+/// profile, BENCHMARKS.md, CAD import), where a spinner would only flash.
 pub const LARGE_INPUT_BYTES: u64 = 4 << 20;
 
 /// How often a spinner redraws: often enough to show it is alive, rarely enough to cost

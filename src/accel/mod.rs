@@ -3,7 +3,7 @@
 //! - [`bvh`]: a SAH bounding volume hierarchy over tight patch boxes (LG90 §3.1 Fig. 2
 //!   boxes; Dammertz §3.2), traversed nearest-first, serializable to a versioned file.
 //! - [`mapped`]: a scene's BVH file, the tree and the prepared patches, mapped by
-//!   `render --bvh` (issue 19).
+//!   `render --bvh`.
 //! - [`grid`]: the uniform grid of LG90 §3.1 with `l_a(S)` registration, mailboxes and a
 //!   3D DDA that stops after the voxel holding the closest hit.
 

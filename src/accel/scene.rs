@@ -977,8 +977,8 @@ struct Patches {
 /// All Bézier patches of the scene in contract order, with their (object, patch) ids and
 /// trims. Patches collapsed to a curve or a point are left out: they have no area, so no
 /// ray hits them exactly, while rounding would let the `f32` kernel report hits on them
-/// whose secondary rays, lacking a normal to leave along, re-hit the same curve (issue 7).
-/// So are patches their trim loops cut away wholly (culling, issue 15).
+/// whose secondary rays, lacking a normal to leave along, re-hit the same curve.
+/// So are patches their trim loops cut away wholly (culled).
 fn collect_patches(objects: &[(u32, &Geometry)]) -> Patches {
     let mut out = Patches {
         originals: Vec::new(),

@@ -1,4 +1,4 @@
-//! `patchtrace bench stability`: the numerical stability suite of issue 7.
+//! `patchtrace bench stability`: the numerical stability suite.
 
 use std::io::Write;
 use std::process::ExitCode;

@@ -243,7 +243,7 @@ pub fn tessellate(
 
 /// Most `--threads` per core. Work is split into many more pieces than threads, so more
 /// threads than cores only add switching; a few per core leave room for a machine whose
-/// core count is misreported, while 10000 spent 20 s starting threads (issue 21).
+/// core count is misreported, while 10000 spent 20 s starting threads.
 pub const MAX_THREADS_PER_CORE: usize = 4;
 
 /// A rayon pool with `threads` workers (all cores when `None`), at most

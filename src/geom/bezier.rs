@@ -260,7 +260,7 @@ impl BezierPatch {
     ///
     /// Every hit's normal comes from here, so the rows and columns live on the stack: sized
     /// for bicubic patches where they fit (the heap vectors they replace were a tenth of
-    /// the teapot render's time, BENCHMARKS.md, issue 19), for [`MAX_DEGREE`] otherwise.
+    /// the teapot render's time, BENCHMARKS.md, scenes at scale), for [`MAX_DEGREE`] otherwise.
     /// The arithmetic is the same either way.
     pub fn derivatives(&self, u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
         if self.degree_u.max(self.degree_v) <= 3 {

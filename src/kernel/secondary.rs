@@ -13,7 +13,7 @@ pub const DEFAULT_ULPS: u32 = 7;
 
 /// Largest `--ulps`: 2^12 ulps move an origin by 2^-11 of its coordinate, hundreds of
 /// times the rounding error any kernel leaves (Dammertz §2.4.2 needs 7), while 2^32 moved
-/// origins across the scene and cost seconds per pixel (issue 21).
+/// origins across the scene and cost seconds per pixel.
 pub const MAX_ULPS: u32 = 1 << 12;
 
 /// Origin of a secondary ray: the corner of the hit box chosen by the octant of the normal

@@ -100,7 +100,7 @@ pub fn write_png(path: &Path, info: &PieceInfo, rgba8: &[u8]) -> Result<(), Load
         enc.set_depth(png::BitDepth::Eight);
         // fdeflate's PNG-tuned compressor: the default zlib level took 4 % of the teapot
         // render's CPU time, this 0.3 %, for files 1.44 times as large (106 KB against
-        // 74 KB at 512², BENCHMARKS.md, issue 19).
+        // 74 KB at 512², BENCHMARKS.md, scenes at scale).
         enc.set_compression(png::Compression::Fast);
         let text = |e: png::EncodingError| std::io::Error::other(e);
         enc.add_text_chunk(PROVENANCE_KEY.into(), info.provenance.clone())

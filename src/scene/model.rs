@@ -29,7 +29,7 @@ pub const MAX_IMAGE_EDGE: u32 = 1 << 15;
 
 /// Largest film one render holds, in pixels: 2^26 (8192 × 8192). The film keeps an `f32`
 /// RGBA value per pixel, 16 bytes, so this is 1 GiB; a 100000 × 100000 request asked for
-/// 160 GB at once (issue 21). Larger images are rendered in pieces (`--tile`, `--crop`).
+/// 160 GB at once. Larger images are rendered in pieces (`--tile`, `--crop`).
 pub const MAX_IMAGE_PIXELS: u64 = 1 << 26;
 
 impl Camera {
@@ -459,7 +459,7 @@ pub struct Scene {
     pub unread_bounds: Option<DAabb>,
 }
 
-/// Default recursion limit for reflection and refraction (issue 3).
+/// Default recursion limit for reflection and refraction.
 pub const DEFAULT_MAX_DEPTH: u32 = 5;
 /// Default ambient fraction.
 pub const DEFAULT_AMBIENT: f32 = 0.1;

@@ -125,7 +125,7 @@ pub fn parse_ray_line(
 }
 
 /// Rays read from a file a chunk at a time, so that `trace` holds one chunk in memory
-/// however long the file is (issue 21: 10 M rays took 2.26 GB and aborted). Lines are read
+/// however long the file is (10 M rays took 2.26 GB and aborted). Lines are read
 /// as bytes, so invalid UTF-8 is reported at its line and column.
 pub struct RayChunks<R> {
     path: std::path::PathBuf,
@@ -232,7 +232,7 @@ mod tests {
 
     #[test]
     fn components_beyond_f32_and_vanishing_directions_are_refused_where_they_stand() {
-        // Issue 21: origin 4e38 rounded to inf in f32 and overflowed the BVH stack.
+        // origin 4e38 rounded to inf in f32 and overflowed the BVH stack.
         let e = parse_rays(Path::new("r"), "0 0 0 0 0 1\n4e38 -8e38 4e38 -1 2 -1\n").unwrap_err();
         assert_eq!((e.line, e.column), (2, 1), "{e}");
         assert!(

@@ -321,7 +321,7 @@ pub fn read_scene_keyed(
 
 /// The deepest `max_depth` a scene may ask for. Each level can double the ray tree (a
 /// material that both reflects and transmits), and the integrator recurses once per level,
-/// so an unbounded value overflowed the stack (issue 21: `max_depth: 100000`). 64 bounces
+/// so an unbounded value overflowed the stack (`max_depth: 100000`). 64 bounces
 /// is far beyond what an 8-bit or half-float pixel can show: with the adaptive cut-off a
 /// ray's weight falls below 1/255 long before, unless every surface is a perfect mirror.
 pub const MAX_TRACE_DEPTH: u32 = 64;

@@ -78,7 +78,7 @@ pub enum TessellateError {
 /// Most triangles one tessellation may make: 2^24 (16.7 M), 12 bytes of indices each plus
 /// about half a vertex each (24 bytes, and the welding map's entry), about 1 GB in all.
 /// Dammertz's finest table row (131072 per patch) on the 32-patch teapot is 4.2 M;
-/// `--grid 100000,100000` asked for 40 GB (issue 21).
+/// `--grid 100000,100000` asked for 40 GB.
 pub const MAX_TRIANGLES: u64 = 1 << 24;
 
 /// Size of a tessellation. `bytes` is the memory the triangle path renders from: `f32`

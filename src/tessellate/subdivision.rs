@@ -1,5 +1,5 @@
 //! Catmull–Clark surfaces tessellated by uniform sampling of their limit surface, per quad
-//! after the first step (the issue 20 `tessellate` item), not per Bézier patch: near an
+//! after the first step, not per Bézier patch: near an
 //! extraordinary vertex a quad is covered by up to 3 · levels + 1 patches of the load-time
 //! refinement ([`crate::geom::subdiv::adaptive`]), and a grid per patch would spend the
 //! requested rate on each of them (the OpenSubdiv cube at 16 × 16 per patch: 1320 patches,

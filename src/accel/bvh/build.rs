@@ -47,7 +47,7 @@ pub(super) const TRAVERSAL_COST: f64 = 1.0;
 pub(super) const PRIM_COST: f64 = 1.0;
 
 /// SAH cost per started pack of packed primitives: one pack test costs about one wide node
-/// test (callgrind, BENCHMARKS.md issue 4: ≈ 160 against ≈ 130 instructions), so a leaf of
+/// test (callgrind, BENCHMARKS.md, scenes at scale: ≈ 160 against ≈ 130 instructions), so a leaf of
 /// one to four packed primitives costs what a lone primitive does and the heuristic keeps
 /// packs full instead of splitting them into half-empty ones.
 pub(super) const PACK_COST: f64 = 1.0;

@@ -30,9 +30,9 @@ use super::{Bvh, Node};
 /// text-mode transfers, as in PNG's signature.
 pub const MAGIC: [u8; 8] = *b"\x89PTBVH\r\n";
 
-/// The format version this build writes and reads. Version 2 (issue 19) keys the file by
+/// The format version this build writes and reads. Version 2 keys the file by
 /// its inputs' bytes, checksums with xxh3 and appends the prepared patches; version 3
-/// (session 10) adds to each patch record where a subdivision surface's patch lies in its
+/// adds to each patch record where a subdivision surface's patch lies in its
 /// quad, which `trace` reports.
 pub const FORMAT_VERSION: u32 = 3;
 

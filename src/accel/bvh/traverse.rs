@@ -128,7 +128,7 @@ impl Bvh {
         // which holds only for a finite origin and direction: from an infinite origin every
         // plane is at t = +inf (or NaN), so `enter <= exit` holds in every lane, the unused
         // lanes' child (index 0, the root) is pushed again and again, and the stack
-        // overflows (issue 21: origin 4e38 rounds to inf in f32). With finite values an
+        // overflows (origin 4e38 rounds to inf in f32). With finite values an
         // empty lane's near plane is +inf and its far plane -inf on every axis (the
         // reciprocal of a finite direction is never 0), so it is never entered. Such a ray
         // meets nothing the kernels could represent anyway.
@@ -143,7 +143,7 @@ impl Bvh {
         // entries below them were); the wide tree is no deeper than the binary one, which
         // the builder and `validate` keep below MAX_DEPTH. Left
         // uninitialised: zeroing its 1.5 KB was two thirds of the instructions per ray
-        // (callgrind, BENCHMARKS.md issue 4).
+        // (callgrind, BENCHMARKS.md, scenes at scale).
         let mut stack = [MaybeUninit::<(Child, f32)>::uninit(); (WIDTH - 1) * MAX_DEPTH];
         let mut top = 0;
         let mut current = Child { index: 0, count: 0 };

@@ -144,7 +144,7 @@ impl Grid {
     ) -> bool {
         // The list of (voxel, primitive) pairs is the peak of the build (16 bytes a pair,
         // the final table keeps 4), so the budget counts it: at 4 bytes a pair a mutated
-        // scene took four times its budget (issue 21: 1 GB for the default 256 MiB).
+        // scene took four times its budget (1 GB for the default 256 MiB).
         let max_pairs = limit / size_of::<(u64, u32)>();
         let mut pairs: Vec<(u64, u32)> = Vec::new();
         let target = self.edge / K;

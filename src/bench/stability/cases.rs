@@ -1,4 +1,4 @@
-//! The hard cases of the stability suite (issue 7): each a scene and a ray set built
+//! The hard cases of the stability suite: each a scene and a ray set built
 //! deterministically from a seed. The geometry is rounded to `f32` once here (the precision
 //! scenes are stored in for rendering, DESIGN.md conventions), so every kernel path and the
 //! `f64` reference see the same surface and a disagreement measures a kernel, not the
@@ -50,20 +50,20 @@ pub struct Case {
     pub rays: Vec<Ray>,
 }
 
-/// Scale factors of the teapot (issue 7: 1e-6 to 1e6).
+/// Scale factors of the teapot (1e-6 to 1e6).
 const TEAPOT_SCALES: [f64; 5] = [1e-6, 1e-3, 1.0, 1e3, 1e6];
-/// Distances of the moved teapot from the origin (issue 7: "up to 1e5").
+/// Distances of the moved teapot from the origin ("up to 1e5").
 const TEAPOT_OFFSETS: [f64; 2] = [1e3, 1e5];
-/// Smallest grazing angle in radians (issue 7); angles are spread log-uniformly up to
+/// Smallest grazing angle in radians; angles are spread log-uniformly up to
 /// [`GRAZING_MAX`].
 const GRAZING_MIN: f64 = 1e-6;
 const GRAZING_MAX: f64 = 1e-1;
 /// Silhouette rays pass this many `f32` ulps inside or outside the outline.
 const SILHOUETTE_ULPS: i32 = 4;
-/// Weights of the rational case span this range (issue 7).
+/// Weights of the rational case span this range.
 const WEIGHT_MIN: f64 = 1e-3;
 const WEIGHT_MAX: f64 = 1e3;
-/// Scale and offset of the plates with a round hole (issue 15: scales 1e-3, 1, 1e3 and an
+/// Scale and offset of the plates with a round hole (scales 1e-3, 1, 1e3 and an
 /// offset of 1e4).
 const HOLED_PLATES: [(f64, f64); 4] = [(1e-3, 0.0), (1.0, 0.0), (1e3, 0.0), (1.0, 1e4)];
 /// The hole's radius in the plate's [0,1]² parameters, about its centre.
@@ -73,7 +73,7 @@ const HOLE_RADIUS: f64 = 0.3;
 /// the plate with the largest coordinates (1e4 + 1: an f32 ulp of 1e-3) to 1e-2.
 const HOLE_DISTANCE_MIN: f64 = 1e-5;
 const HOLE_DISTANCE_MAX: f64 = 1e-2;
-/// Size ratio of the tiny and the huge patch (issue 7).
+/// Size ratio of the tiny and the huge patch.
 const TINY_HUGE_RATIO: f64 = 1e6;
 /// A scale that puts the teapot's control points at ~1e-40, below `f32::MIN_POSITIVE`
 /// (1.18e-38): its coordinates are subnormal in `f32`.

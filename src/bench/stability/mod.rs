@@ -1,4 +1,4 @@
-//! The numerical stability suite (issue 7): hard cases ([`cases`]) run against every kernel
+//! The numerical stability suite: hard cases ([`cases`]) run against every kernel
 //! path and compared ray by ray with the `f64` reference ([`run`]), summarised as a
 //! Markdown or CSV table ([`report`]). The acceptance criteria of the float-precision
 //! kernel are [`Criterion`]s, checked by `tests/stability_suite.rs` on the reduced suite.
@@ -15,17 +15,16 @@ pub use cases::{Case, SuiteSize, all_cases};
 pub use run::{BOX_TOLERANCE_ULPS, Figures, KernelPath, SplitFigures, run_case};
 
 /// Largest median distance from the reference hit across the surface (along its normal), in
-/// ulps of the hit's largest coordinate
-/// (issue 7, "done when").
+/// ulps of the hit's largest coordinate (the suite's acceptance criterion).
 pub const MAX_MEDIAN_ULPS: f64 = 4.0;
 
 /// Largest number of de Casteljau splits one ray–patch test may take: the kernel's proven
 /// bound (src/kernel/subdivision/search.rs), 4096 at full precision and 24 doublings of a
 /// coarsening end game 64 splits apart. Without that budget the work has no bound: a
-/// grazing ray hits about 1/θ boxes per level (BENCHMARKS.md, issue 7).
+/// grazing ray hits about 1/θ boxes per level (BENCHMARKS.md, stability).
 pub const MAX_SPLITS_PER_PATCH_TEST: u64 = crate::kernel::subdivision::MAX_SPLITS_PER_TEST;
 
-/// One acceptance criterion of issue 7 for the float-precision kernel.
+/// One acceptance criterion for the float-precision kernel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Criterion {
     Holes,
@@ -55,7 +54,7 @@ impl Figures {
     /// The criteria these figures fail.
     pub fn failures(&self) -> Vec<Criterion> {
         if self.refused.is_some() {
-            // Refusing with a clear message is the accepted answer for such input (issue 7).
+            // Refusing with a clear message is the accepted answer for such input.
             return Vec::new();
         }
         let splits_unbounded = self

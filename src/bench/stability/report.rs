@@ -1,5 +1,5 @@
 //! The stability table: Markdown for people, CSV for tools. One row per case and kernel
-//! path, with the criteria the row fails (issue 7) in the last column.
+//! path, with the criteria the row fails in the last column.
 
 use std::fmt::Write;
 

@@ -127,7 +127,7 @@ pub struct SplitFigures {
 /// Runs every ray of `case` through `path` and the reference, and renders the case scene
 /// at `image_size`² to count NaN pixels.
 pub fn run_case(case: &Case, path: KernelPath, image_size: u32, seed: u64) -> Figures {
-    // Issue 7 allows inputs near the denormal range to be "flushed or refused with a clear
+    // The stability criteria allow inputs near the denormal range to be "flushed or refused with a clear
     // message": the loader refuses them, so such a case checks the refusal instead.
     if let Err(e) = check_f32_range(Path::new(&case.name), &case.scene) {
         return Figures {

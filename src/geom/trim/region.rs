@@ -8,7 +8,7 @@
 //! 144 whose outer boundary is the domain's): every point of the domain lies inside that
 //! boundary, so the parity is inverted rather than the boundary traced.
 //!
-//! Culling (issue 15): for a patch covering the rectangle R of the trim space, only pieces
+//! Culling: for a patch covering the rectangle R of the trim space, only pieces
 //! that can cross a half-line starting in R matter: a piece wholly left of R, above it or
 //! below it never does. A piece wholly right of R crosses every such half-line to the right
 //! of its start, so its end points alone decide (it is kept as its chord). The rest overlap

@@ -34,14 +34,14 @@ use tree::SurfaceTree;
 /// nodes are 72 bytes (`f64` parameter boxes, an `f32` box, a child index, a sub-net slot)
 /// and each leaf keeps its sub-net (272 bytes for a bicubic patch, [`tree::LeafNet`]); LG90
 /// test case 1 at 512² (one teapot) grows about 90 k nodes, some 22 MiB, in a single worker
-/// at [`DEFAULT_MAX_DEPTH`] (BENCHMARKS.md, Issue 6), so 32 MiB holds it without evictions
+/// at [`DEFAULT_MAX_DEPTH`] (BENCHMARKS.md, LG90 cache), so 32 MiB holds it without evictions
 /// while staying small next to a machine's memory.
 pub const DEFAULT_CACHE_BYTES: usize = 32 << 20;
 
 /// Depth below which tree nodes are not cached (the paper's conclusion, §8). Depth 6
 /// leaves are 1/64 of the domain on a side: at 512² a teapot patch covers about 50 × 50
 /// pixels, so a depth-6 leaf is about a pixel and deeper nodes would serve about one ray
-/// each; measured against depth 10 in BENCHMARKS.md (Issue 6).
+/// each; measured against depth 10 in BENCHMARKS.md.
 pub const DEFAULT_MAX_DEPTH: u8 = 6;
 
 /// Settings of the cached kernel.

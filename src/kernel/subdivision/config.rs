@@ -37,7 +37,7 @@ pub const DEFAULT_END_ULPS: u32 = 8;
 /// Splits a ray–patch test takes at full precision before its end game coarsens
 /// ([`SubdivisionConfig::full_precision_splits`]). A ray that runs at a small angle θ to the
 /// surface over a stretch hits about 1/θ boxes on every level, each of which must be split
-/// before the nearest-first search can reject it (BENCHMARKS.md, issue 7 diagnosis), so
+/// before the nearest-first search can reject it (BENCHMARKS.md, stability), so
 /// without a budget the work has no bound in θ. A coarsened box is entered where the ray
 /// runs within that box's size above the surface, which on a grazing ray can be far along
 /// it from the crossing, so the budget is set above what ordinary rays need: the teapot's

@@ -4,7 +4,7 @@
 //! Why: the search (Dammertz §2.2) halves one parameter direction per split, so reaching
 //! an `f32`-sized box takes ~46 splits on the teapot, each a dependent chain of de
 //! Casteljau, box and test whose child choice the branch predictor cannot guess
-//! (BENCHMARKS.md, issue 3). Once a sub-patch is nearly linear, where the ray crosses it
+//! (BENCHMARKS.md, kernel). Once a sub-patch is nearly linear, where the ray crosses it
 //! is known to a small fraction of the cell from its centre point and mean derivatives,
 //! and the search can go straight to the dyadic sub-cell holding that fraction: halving
 //! towards a known cell needs no box, no test and no branch.
@@ -43,7 +43,7 @@
 //! The jump never decides a hit by itself: the final box is still found by the halving
 //! search (Dammertz §2.2), inside the sub-cell. What a jump can change is a ray that
 //! passes within a final box's size of a patch's boundary without crossing the patch,
-//! which the halving search may report as a hit and a dropped cell does not (issue 3 asks
+//! which the halving search may report as a hit and a dropped cell does not (the accuracy criterion asks
 //! hit and miss to agree with `f64` only away from a few ulps of the silhouette); at a
 //! fold silhouette `J₀` is near singular and no jump is tried.
 
@@ -57,12 +57,12 @@ const MAX_CONTRACTION: f64 = 0.5;
 /// of the module documentation: more than the rounding of the `f32` centre point (a sum
 /// of 16 products) and of a sub-net made by [`restriction`] (two matrix products of
 /// rounded weights, about 8 ulps), each a few ulps of that magnitude. The jumps' counts on
-/// the teapot are the same from 4 to 128 (BENCHMARKS.md, issue 3).
+/// the teapot are the same from 4 to 128 (BENCHMARKS.md, kernel).
 const ROUNDING_ULPS: f64 = 32.0;
 
 /// A jump is taken from this many levels on, in both directions together. Once the plan is
 /// made, even one level of descent and a box test cost less than the split they replace
-/// (measured from 1 to 6, BENCHMARKS.md, issue 3).
+/// (measured from 1 to 6, BENCHMARKS.md, kernel).
 const MIN_JUMP_LEVELS: u8 = 1;
 
 /// What a jump needs of a sub-patch in ray space, over cell parameters `[0,1]²`: its

@@ -17,10 +17,10 @@
 //! Two rules keep the work bounded. A ray at a small angle θ to the surface hits about 1/θ
 //! boxes on every level along the stretch where it runs close to the surface, and the
 //! nearest-first search must split each before it can reject it, so the work has no bound
-//! in θ (BENCHMARKS.md, issue 7).
+//! in θ (BENCHMARKS.md, stability).
 //! - Once a final box is hit, a pending box entered less than that box's extent (largest
 //!   edge, over the largest direction component) before the hit is dropped: a hit in it
-//!   would lie within the final box's extent of the one found (issue 7 counts hits within
+//!   would lie within the final box's extent of the one found (the stability criteria count hits within
 //!   the final box's own extent as agreeing), and its sub-boxes are entered no earlier,
 //!   since de Casteljau averages stay within the parent's coordinates.
 //! - After [`SubdivisionConfig::full_precision_splits`] splits the end game coarsens: the
@@ -90,7 +90,7 @@ pub struct Node<T> {
 
 /// Jumps are tried from this many levels (u + v) on: on coarser cells the teapot's
 /// sub-patches are rarely linear enough for a jump, and the refused tries cost more than
-/// they save (measured from 2 to 14 levels, BENCHMARKS.md, issue 3).
+/// they save (measured from 2 to 14 levels, BENCHMARKS.md, kernel).
 const JUMP_FROM_LEVEL: u8 = 6;
 
 /// Levels (u + v) below a node whose jump did not apply before its descendants try again

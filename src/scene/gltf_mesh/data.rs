@@ -2,7 +2,7 @@
 //! really there before anything is allocated or indexed: every index in range, every
 //! `byteOffset + byteLength` inside its buffer, strides at least one element and within
 //! 4..=252 (§3.6.2.4), and `offset + stride · (count - 1) + element size` inside the buffer
-//! view, so a declared `count` can never ask for more than the file holds (issue 21: an
+//! view, so a declared `count` can never ask for more than the file holds (an
 //! accessor count beyond its buffer allocated 3.7 GB and aborted in `gltf`).
 
 use std::path::Path;

@@ -1,7 +1,7 @@
 //! The GLB container (glTF 2.0 §4.4 "Binary glTF Layout"): a 12-byte header (magic
 //! `glTF`, version 2, total length), a JSON chunk, then an optional BIN chunk, each chunk a
 //! length, a type and the data. Every length is checked against the bytes really there
-//! before anything is sliced, so a header declaring 4 GB reads nothing (issue 21: a
+//! before anything is sliced, so a header declaring 4 GB reads nothing (a
 //! declared length of 1 allocated 4 GB in `gltf`).
 
 use super::super::error::BinaryError;
@@ -132,7 +132,7 @@ mod tests {
             (g.json, g.json_start, g.bin),
             (&b"{}  "[..], 20, Some(&b"abcd"[..]))
         );
-        // A declared total length of 1 (issue 21) or of more than the file.
+        // A declared total length of 1 or of more than the file.
         for bad in [1u32, file.len() as u32 + 1, u32::MAX] {
             let mut f = file.clone();
             f[8..12].copy_from_slice(&bad.to_le_bytes());

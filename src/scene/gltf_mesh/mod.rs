@@ -4,7 +4,7 @@
 //! and validated here before any index is followed, instead of going through the `gltf`
 //! crate's iterators, which index unchecked: an attribute pointing past the accessor list
 //! panicked in `gltf-json`, an unexpected accessor type reached `unreachable!` in `gltf`,
-//! and declared counts allocated gigabytes (issue 21).
+//! and declared counts allocated gigabytes.
 //!
 //! - [`glb`]: the binary container (§4.4), lengths checked against the file.
 //! - [`data`]: buffers and accessors (§3.6), bounds checked against the bytes.

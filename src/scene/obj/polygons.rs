@@ -2,7 +2,7 @@
 //! `v`, `vt`, `vn`, `f`) read as one triangle mesh: faces triangulated as fans from their
 //! first corner, one vertex per distinct (position, normal) pair, normals kept when every
 //! corner has one. Our own reader instead of `tobj` so that every error says where it is
-//! (issue 21: "the OBJ mesh reader cannot tell the line"): each reference is checked
+//! ("the OBJ mesh reader cannot tell the line"): each reference is checked
 //! against the vertices defined before it (relative indices count back from there).
 //! Statements without geometry (`o`, `g`, `s`, `usemtl`, `mtllib`, `l`, `p`, …) are
 //! skipped.

@@ -1,0 +1,129 @@
+//! `tessellate` and `compare` through the binary, and meshes rendering like patches.
+
+use crate::common;
+
+use common::{run, stderr, stdout, testdata};
+
+#[test]
+fn obj_and_gltf_of_the_same_mesh_render_the_same_pixels() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut images = Vec::new();
+    for name in ["quad_mesh.obj", "quad_mesh.gltf"] {
+        let out = dir.path().join(format!("{name}.png"));
+        let o = run(&[
+            "render",
+            testdata(name).to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+            "--width",
+            "48",
+            "--height",
+            "48",
+            // glTF is framed y-up by default, OBJ z-up: the same framing for both.
+            "--up",
+            "z",
+        ]);
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        // The pixels, not the file: the file records the scene's fingerprint, and the two
+        // readers' meshes differ in what the fingerprint sees (e.g. stored normals).
+        images.push(image::open(&out).unwrap().to_rgba8().into_raw());
+    }
+    assert!(images[0] == images[1]);
+}
+
+#[test]
+fn a_tessellated_scene_renders_close_to_the_direct_one() {
+    // 4608 triangles per patch: the image differs from the exact surfaces only by shading
+    // and silhouette details (Dammertz Table 2.1's middle row).
+    let dir = tempfile::tempdir().unwrap();
+    let o = run(&[
+        "compare",
+        testdata("teapot.ron").to_str().unwrap(),
+        "--triangles",
+        "8,4608",
+        "--out-dir",
+        dir.path().to_str().unwrap(),
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let csv = std::fs::read_to_string(dir.path().join("compare.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), 3);
+    assert_eq!(rows[0][6], "inf", "the direct image against itself");
+    let rmse = |r: &Vec<&str>| r[5].parse::<f64>().unwrap();
+    // More triangles, less error; both well below an unrelated image's (RMSE ~0.3).
+    assert!(rmse(&rows[2]) < rmse(&rows[1]), "{csv}");
+    assert!(rmse(&rows[2]) < 0.02, "{csv}");
+    let triangles = |r: &Vec<&str>| r[1].parse::<u64>().unwrap();
+    assert!(triangles(&rows[2]) > 100 * triangles(&rows[1]));
+    for f in [
+        "direct.png",
+        "tess8.png",
+        "tess4608.png",
+        "flip8.png",
+        "flip4608.png",
+        "compare.md",
+    ] {
+        assert!(dir.path().join(f).exists(), "{f} missing");
+    }
+    assert!(stdout(&o).starts_with("| method |"));
+}
+
+#[test]
+fn tessellate_writes_each_format_and_reports_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    for (ext, args) in [
+        ("obj", vec!["--triangles-per-patch", "512"]),
+        ("gltf", vec!["--grid", "4,3"]),
+        ("glb", vec!["--tolerance", "0.01"]),
+    ] {
+        let out = dir.path().join(format!("t.{ext}"));
+        let input = testdata("teapot.bpt");
+        let mut a = vec![
+            "tessellate",
+            input.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--json",
+        ];
+        a.extend(args.iter().copied());
+        let o = run(&a);
+        assert!(o.status.success(), "{ext}: {}", stderr(&o));
+        let r: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+        assert!(r["triangles"].as_u64().unwrap() > 0);
+        assert_eq!(
+            r["file_bytes"].as_u64().unwrap(),
+            std::fs::metadata(&out).unwrap().len()
+        );
+        // The written mesh loads back as a scene with that many triangles.
+        let scene = patchtrace::scene::load_scene(&out).unwrap();
+        let tris: usize = scene
+            .objects
+            .iter()
+            .map(|o| match &o.geometry {
+                patchtrace::scene::Geometry::Mesh(m) => m.indices.len(),
+                _ => 0,
+            })
+            .sum();
+        assert_eq!(tris as u64, r["triangles"].as_u64().unwrap(), "{ext}");
+    }
+    let o = run(&[
+        "tessellate",
+        testdata("teapot.bpt").to_str().unwrap(),
+        "-o",
+        dir.path().join("x.obj").to_str().unwrap(),
+        "--triangles-per-patch",
+        "7",
+    ]);
+    assert_ne!(o.status.code(), Some(0));
+    assert!(stderr(&o).contains("even count"), "{}", stderr(&o));
+}
