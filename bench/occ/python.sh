@@ -9,8 +9,8 @@ set -eu
 # No __pycache__ inside the repository.
 export PYTHONDONTWRITEBYTECODE=1
 if [ -n "${OCC_PYTHON:-}" ]; then
-    if ! "$OCC_PYTHON" -c 'import OCP' 2>/dev/null; then
-        echo "occ: OCC_PYTHON=$OCC_PYTHON cannot import OCP (pip install cadquery-ocp-novtk numpy)" >&2
+    if ! "$OCC_PYTHON" -c 'import OCP, numpy' 2>/dev/null; then
+        echo "occ: OCC_PYTHON=$OCC_PYTHON cannot import OCP and numpy (pip install cadquery-ocp-novtk numpy)" >&2
         exit 3
     fi
     exec "$OCC_PYTHON" "$@"
