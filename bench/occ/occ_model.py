@@ -30,7 +30,7 @@ IGES_SUFFIXES = (".igs", ".iges")
 
 
 class ReadError(Exception):
-    """OpenCASCADE could not read the file, or read nothing it can trace."""
+    """OpenCASCADE could not read the file, or read no faces from it."""
 
 
 def is_cad_file(path):
@@ -132,7 +132,7 @@ def _reader(path):
 
 def _writer(reader):
     """The writing system named in the file's header: STEP FILE_NAME originating_system
-    (ISO 10303-21 §8.2.2), IGES Global parameter 5, native system ID (IGES 5.3 §2.2.4.3)."""
+    (ISO 10303-21 §8.2.2), or the IGES Global section's parameter 5, native system ID."""
     try:
         if isinstance(reader, STEPControl_Reader):
             name = APIHeaderSection_MakeHeader(reader.StepModel()).OriginatingSystem()

@@ -13,7 +13,9 @@
 
 Origins lie on the sphere of radius twice the model size about the box centre, so every
 origin is outside the model. Faces are drawn uniformly, so small faces (fillets, chamfers)
-get as many rays as large ones. Directions are unit vectors, so `t` is a distance in mm.
+get as many rays as large ones; when FACES_PER_RAY faces in a row give no target (a model
+of untrimmed faces has no trimmed-away points), the ray is made `random` instead, and its
+kind says so. Directions are unit vectors, so `t` is a distance in mm.
 Everything is drawn from one `random.Random` seeded from the seed and the file's name:
 the same seed, file and OpenCASCADE version give the same rays.
 """
