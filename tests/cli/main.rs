@@ -13,6 +13,7 @@ mod compare;
 mod convert;
 mod diff_cli;
 mod errors;
+mod examples;
 mod formats_cli;
 mod frames;
 mod hostile_input;
