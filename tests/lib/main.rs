@@ -19,6 +19,7 @@ mod bvh_packed;
 mod bvh_traverse;
 mod cached_agreement;
 mod cached_render;
+mod cad_front_door;
 mod diff_metrics;
 mod formats_iges;
 mod formats_mesh;
