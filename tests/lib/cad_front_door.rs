@@ -171,3 +171,30 @@ fn a_step_file_with_nothing_renderable_exits_2() {
         assert!(!out.exists());
     }
 }
+
+/// A Windows path with single backslashes in FILE_NAME (MSC.Patran writes one): `\T` and
+/// `\t` begin no control directive of ISO 10303-21 §6.4.3, so they are kept as text with
+/// one warning, as OpenCASCADE reads the file, and the part is read whole.
+#[test]
+fn backslashes_that_begin_no_escape_are_text_with_one_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = step_support::bracket(1).replacen(
+        "FILE_NAME('test.step'",
+        "FILE_NAME('C:\\TEMP\\test.step'",
+        1,
+    );
+    let line = text.lines().position(|l| l.contains("C:\\TEMP")).unwrap() + 1;
+    let path = dir.path().join("windows.step");
+    std::fs::write(&path, text).unwrap();
+    let o = run(&["info", path.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(common::stdout(&o).contains("faces: 8 converted, 0 failed"));
+    let err = stderr(&o);
+    let warnings: Vec<&str> = err.lines().filter(|l| l.starts_with("warning:")).collect();
+    assert_eq!(warnings.len(), 1, "{err}");
+    assert!(
+        warnings[0].contains(&format!("windows.step: {line}:11: 2 backslash(es)")),
+        "{err}"
+    );
+    assert!(warnings[0].contains("first `\\TE`"), "{err}");
+}

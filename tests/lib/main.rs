@@ -33,6 +33,7 @@ mod lg6_trivial;
 mod robust_mesh_files;
 mod robust_parsers;
 mod stability_suite;
+mod step_assembly;
 mod step_entities;
 mod step_part;
 mod subdiv_surface;

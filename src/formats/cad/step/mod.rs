@@ -347,6 +347,7 @@ pub fn read_model(path: &Path, src: &str) -> Result<(CadModel, Report), ParseErr
     report.colours = palette.len();
     report.unsupported = unsupported;
     model.held = held(&ex, seen.len());
+    model.warnings = ex.warnings.clone();
     model.notes = report.lines();
     model.skipped = report.unsupported.clone();
     model.failures = report
