@@ -12,7 +12,8 @@
 //! | 8 | 8 | record count `u64` (the tree's primitive count when there are records) |
 //! | 16 | 8 | trim loops in the scene `u64` (for the effect line; none cuts a mapped patch) |
 //! | 24 | 8 | record size `u64` ([`PatchRecord`], 680) |
-//! | 32 | 680 × records | [`PatchRecord`]s, in primitive order |
+//! | 32 | 24 | floating origin, three `f64` ([`crate::scene::origin`]) |
+//! | 56 | 680 × records | [`PatchRecord`]s, in primitive order |
 //! | … | 8 | [`checksum`] of the section before it |
 //!
 //! Then the scene section, the scene file's parse for `render --bvh` to skip the RON parse
@@ -20,6 +21,9 @@
 //! geometry file the key of its inputs), the length `u64` of the JSON that follows
 //! (`ron_format::SceneFile`, or for a bare geometry file its scene without geometry,
 //! `scene::bare_shell::BareShell`), the JSON, and the [`checksum`] of the section.
+//!
+//! The tree and the records are built in the scene moved by minus the floating origin
+//! (format version 4); the scene section keeps the scene where it was.
 //!
 //! Records hold what the render reads of a patch: the `f32` net of the bicubic or bilinear
 //! fast path, its box, its (object, patch) number, and the `f64` control points and domain
@@ -72,7 +76,7 @@ const KIND_COLUMNS: u32 = 1;
 /// `kind` of a bilinear net.
 const KIND_BILINEAR: u32 = 2;
 
-const SECTION_HEADER: usize = 32;
+const SECTION_HEADER: usize = 56;
 
 /// `piece_face` of a patch that is not part of a subdivision surface.
 const NO_PIECE: u32 = u32::MAX;
@@ -271,13 +275,14 @@ pub(super) fn records(
 }
 
 /// Writes the file: `bvh`'s tree section with `key`, then the patch section with `records`
-/// (or none) and the scene's `trim_loops`, then the scene section with `parsed` (the
+/// (or none), the scene's `trim_loops` and the floating `origin` it was built at, then the scene section with `parsed` (the
 /// scene's text hash and its parse as JSON, or nothing).
 pub(super) fn write(
     w: &mut dyn Write,
     bvh: &Bvh,
     key: u64,
     (records, trim_loops): (Option<&[PatchRecord]>, usize),
+    origin: DVec3,
     parsed: Option<(u64, &[u8])>,
 ) -> io::Result<()> {
     let tree = bvh.section(key);
@@ -292,6 +297,9 @@ pub(super) fn write(
         records.len() as u64,
         trim_loops as u64,
         size_of::<PatchRecord>() as u64,
+        origin.x.to_bits(),
+        origin.y.to_bits(),
+        origin.z.to_bits(),
     ] {
         section.extend_from_slice(&field.to_le_bytes());
     }
@@ -357,6 +365,8 @@ pub struct BvhFile {
     pub bvh: Bvh,
     pub patches: Option<MappedPatches>,
     pub trim_loops: usize,
+    /// The floating origin the geometry was moved by (minus it) before it was built.
+    pub origin: DVec3,
 }
 
 /// A mapped BVH file whose every section passed its structural and checksum checks, not
@@ -368,6 +378,7 @@ pub struct Opened {
     /// First record and record count, when the file has records.
     records: Option<(usize, usize)>,
     trim_loops: usize,
+    origin: DVec3,
     /// The scene's parse: the hash of its text and the range of its JSON.
     scene: (u64, std::ops::Range<usize>),
 }
@@ -402,6 +413,10 @@ pub fn map(path: &Path) -> Result<Opened, LoadError> {
         (word(at), word(at + 8), word(at + 16), word(at + 24));
     if has_records > 1 {
         return Err(corrupt(at, format!("patch section flag {has_records}")));
+    }
+    let origin = DVec3::from_array([32, 40, 48].map(|k| f64::from_bits(word(at + k))));
+    if !origin.is_finite() {
+        return Err(corrupt(at + 32, format!("floating origin {origin}")));
     }
     if record_size != RECORD_BYTES as u64 {
         return Err(corrupt(
@@ -472,6 +487,7 @@ pub fn map(path: &Path) -> Result<Opened, LoadError> {
         key,
         records,
         trim_loops: usize::try_from(trim_loops).unwrap_or(usize::MAX),
+        origin,
     })
 }
 
@@ -500,6 +516,7 @@ impl Opened {
                 bvh: self.bvh,
                 patches: None,
                 trim_loops: self.trim_loops,
+                origin: self.origin,
             });
         };
         let patches = MappedPatches {
@@ -522,6 +539,7 @@ impl Opened {
             bvh: self.bvh,
             patches: Some(patches),
             trim_loops: self.trim_loops,
+            origin: self.origin,
         })
     }
 }

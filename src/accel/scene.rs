@@ -1090,13 +1090,14 @@ impl SceneGeometry {
 
     /// Writes the BVH file for inputs with key `key`, atomically: the tree, and the
     /// prepared patches when the geometry is only patches the file can hold, with the
-    /// scene's `trim_loops`, and the scene file's `parsed` form (`ron_format::parsed_scene`)
+    /// scene's `trim_loops` and the floating `origin` it was moved by (minus it) before it
+    /// was built, and the scene file's `parsed` form (`ron_format::parsed_scene`)
     /// when there is one; whether it holds the patches. Refused for a grid.
     pub fn save_bvh(
         &self,
         path: &std::path::Path,
         key: u64,
-        trim_loops: usize,
+        (trim_loops, origin): (usize, glam::DVec3),
         parsed: Option<(u64, &[u8])>,
         piece_of: &(dyn Fn(u32, u32) -> Option<Piece> + Sync),
     ) -> Result<bool, crate::io::OutputError> {
@@ -1115,7 +1116,14 @@ impl SceneGeometry {
             _ => None,
         };
         crate::io::write_atomic(path, |w| {
-            mapped::write(w, bvh, key, (records.as_deref(), trim_loops), parsed)
+            mapped::write(
+                w,
+                bvh,
+                key,
+                (records.as_deref(), trim_loops),
+                origin,
+                parsed,
+            )
         })?;
         Ok(records.is_some())
     }

@@ -217,7 +217,7 @@ fn render_frame(
         );
     }
     let start = Instant::now();
-    let layers = aov::channels(&aovs, &rendered);
+    let layers = aov::channels(&aovs, &rendered, prepared.origin);
     let mut written = Vec::new();
     match ImageFormat::of(output) {
         Some(ImageFormat::Exr) => {

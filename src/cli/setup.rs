@@ -5,6 +5,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::Context;
+use glam::DVec3;
 
 use crate::accel::scene::{FromFile, Precision, SceneGeometry};
 use crate::cli::args::{
@@ -92,6 +93,9 @@ pub struct Prepared {
     pub trims: TrimEffect,
     /// The key of the scene's inputs ([`load_scene_keyed`]): what its geometry is made from.
     pub source_key: u64,
+    /// The floating origin ([`crate::scene::origin`]): `scene` and `geometry` are the scene
+    /// as read moved by minus it, and a world position is a position in them plus it.
+    pub origin: DVec3,
 }
 
 /// Reads the scene at `path` with `--subdivide`'s options, under a spinner when the file is
@@ -121,6 +125,8 @@ pub fn prepare(
     if args.ignore_trims {
         scene = scene.without_trims();
     }
+    let origin = scene.floating_origin();
+    scene.translate(-origin);
     let load_seconds = start.elapsed().as_secs_f64();
     let start = Instant::now();
     let geometry = match args.accel {
@@ -139,6 +145,7 @@ pub fn prepare(
         prepare_seconds: start.elapsed().as_secs_f64(),
         trims,
         source_key,
+        origin,
     })
 }
 
@@ -178,6 +185,7 @@ fn prepare_from_file(
     let start = Instant::now();
     let key = crate::accel::mapped::key(source, args.ignore_trims);
     let file = opened.check(bvh_path, key, scene.objects.len())?;
+    let origin = file.origin;
     let (scene, geometry, trims) = match SceneGeometry::from_file(file) {
         FromFile::Mapped(geometry, loops) => {
             let trims = TrimEffect {
@@ -185,6 +193,7 @@ fn prepare_from_file(
                 ignored: args.ignore_trims,
             };
             let mut scene = scene;
+            scene.translate(-origin);
             let pieces = geometry.mapped_pieces(scene.objects.len());
             for (object, pieces) in scene.objects.iter_mut().zip(pieces) {
                 if !pieces.is_empty() {
@@ -205,6 +214,7 @@ fn prepare_from_file(
             if args.ignore_trims {
                 scene = scene.without_trims();
             }
+            scene.translate(-origin);
             let geometry = SceneGeometry::with_tree(&scene, bvh, bvh_path)?;
             (scene, geometry, trims)
         }
@@ -216,6 +226,7 @@ fn prepare_from_file(
         prepare_seconds: start.elapsed().as_secs_f64(),
         trims,
         source_key: source,
+        origin,
     })
 }
 

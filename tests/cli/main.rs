@@ -14,6 +14,7 @@ mod convert;
 mod diff_cli;
 mod errors;
 mod examples;
+mod floating_origin;
 mod formats_cli;
 mod frames;
 mod hostile_input;

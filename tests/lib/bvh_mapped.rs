@@ -163,7 +163,7 @@ fn layout(bytes: &[u8]) -> (usize, usize, usize, usize, usize) {
     let word = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap()) as usize;
     let (nodes, prims) = (word(20), word(28));
     let section = (36 + 32 * nodes + 4 * prims + 8).next_multiple_of(8);
-    let records = section + 32;
+    let records = section + 56;
     let end = records + word(section + 8) * mapped::RECORD_BYTES;
     let scene = end + 8;
     (
