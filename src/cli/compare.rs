@@ -10,13 +10,13 @@ use std::time::Instant;
 
 use anyhow::Context;
 
-use crate::accel::scene::Precision;
 use crate::bench::accuracy::patch_memory;
 use crate::cli::args::CompareArgs;
 use crate::cli::setup::{build_bvh, load, tessellate, thread_pool};
 use crate::diff::heatmap::heat_map;
 use crate::diff::{DiffOptions, Image, diff_images};
 use crate::io::write_atomic;
+use crate::kernel::Kernel;
 use crate::kernel::secondary::DEFAULT_ULPS;
 use crate::kernel::subdivision::SubdivisionConfig;
 use crate::render::film::Film;
@@ -50,7 +50,7 @@ fn render(scene: &Scene, quiet: bool, label: &str, pool: &rayon::ThreadPool) -> 
         scene,
         geometry: &geometry,
         settings: TraceSettings {
-            precision: Precision::F32(SubdivisionConfig::default()),
+            precision: Kernel::F32(SubdivisionConfig::default()),
             ulps: DEFAULT_ULPS,
             plan: EffectPlan::for_scene(scene),
         },

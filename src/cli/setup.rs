@@ -7,12 +7,13 @@ use std::time::Instant;
 use anyhow::Context;
 use glam::DVec3;
 
-use crate::accel::scene::{FromFile, Precision, SceneGeometry};
+use crate::accel::scene::{FromFile, SceneGeometry};
 use crate::cli::args::{
     AccelChoice, HeuristicChoice, KernelArgs, KernelChoice, MeshArgs, PrecisionChoice,
     TerminationChoice,
 };
 use crate::formats::{load_scene_keyed, load_scene_with};
+use crate::kernel::Kernel;
 use crate::kernel::cached::{CachedConfig, DEFAULT_CACHE_BYTES, DEFAULT_MAX_DEPTH};
 use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig, Termination};
 use crate::kernel::toth::TothConfig;
@@ -25,7 +26,7 @@ use crate::tessellate::{
 
 /// The kernel path selected by the flags, or why the flags do not go together; `camera`
 /// sizes the pixels of adaptive termination.
-pub fn precision(args: &KernelArgs, camera: &Camera) -> anyhow::Result<Precision> {
+pub fn precision(args: &KernelArgs, camera: &Camera) -> anyhow::Result<Kernel> {
     if args.kernel != KernelChoice::Cached {
         for (flag, given) in [
             ("--cache-size", args.cache_size.is_some()),
@@ -47,13 +48,13 @@ pub fn precision(args: &KernelArgs, camera: &Camera) -> anyhow::Result<Precision
             ..TothConfig::default()
         };
         return Ok(match args.kernel {
-            KernelChoice::Cached => Precision::Cached(CachedConfig::new(
+            KernelChoice::Cached => Kernel::Cached(CachedConfig::new(
                 toth,
                 args.cache_size
                     .map_or(DEFAULT_CACHE_BYTES, |mib| mib.saturating_mul(1 << 20)),
                 args.cache_depth.unwrap_or(DEFAULT_MAX_DEPTH),
             )),
-            _ => Precision::Toth(toth),
+            _ => Kernel::Toth(toth),
         });
     }
     anyhow::ensure!(
@@ -78,8 +79,8 @@ pub fn precision(args: &KernelArgs, camera: &Camera) -> anyhow::Result<Precision
         cfg.rational_dist = d;
     }
     Ok(match args.precision {
-        PrecisionChoice::F32 => Precision::F32(cfg),
-        PrecisionChoice::F64 => Precision::F64(cfg),
+        PrecisionChoice::F32 => Kernel::F32(cfg),
+        PrecisionChoice::F64 => Kernel::F64(cfg),
     })
 }
 

@@ -7,13 +7,14 @@ use std::process::ExitCode;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::accel::scene::{Precision, QueryStats, SceneGeometry, SceneHit};
+use crate::accel::scene::{QueryStats, SceneGeometry, SceneHit};
 use crate::cli::args::TraceArgs;
 use crate::cli::setup::{precision, prepare, thread_pool};
 use crate::formats::LoadError;
 use crate::formats::rays::{RayChunks, RayQuery};
 use crate::geom::Ray;
 use crate::io::write_atomic;
+use crate::kernel::Kernel;
 use crate::scene::Scene;
 
 /// The header line of the contract.
@@ -82,12 +83,12 @@ fn trace_one(
     geometry: &SceneGeometry,
     q: &RayQuery,
     origin: DVec3,
-    precision: &Precision,
+    precision: &Kernel,
 ) -> Option<(SceneHit, DVec3, DVec3)> {
     let mut stats = QueryStats::default();
     let moved = q.origin - origin;
     match precision {
-        Precision::F32(_) | Precision::Toth(_) | Precision::Cached(_) => {
+        Kernel::F32(_) | Kernel::Toth(_) | Kernel::Cached(_) => {
             let ray = Ray {
                 origin: moved.as_vec3(),
                 dir: q.dir.as_vec3(),
@@ -97,7 +98,7 @@ fn trace_one(
             let hit = geometry.intersect(&ray, precision, &mut stats)?;
             Some((hit, ray.origin.as_dvec3() + origin, ray.dir.as_dvec3()))
         }
-        Precision::F64(cfg) => {
+        Kernel::F64(cfg) => {
             let hit = geometry.intersect_f64(moved, q.dir, q.tmin, q.tmax, cfg, &mut stats)?;
             Some((hit, moved + origin, q.dir))
         }

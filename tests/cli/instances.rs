@@ -8,9 +8,10 @@ use std::path::Path;
 use std::sync::Arc;
 
 use glam::DVec3;
-use patchtrace::accel::scene::{Precision, QueryStats, SceneGeometry, SceneHit};
+use patchtrace::accel::scene::{QueryStats, SceneGeometry, SceneHit};
 use patchtrace::formats::load_scene;
 use patchtrace::geom::{DAabb, Ray};
+use patchtrace::kernel::Kernel;
 use patchtrace::kernel::subdivision::SubdivisionConfig;
 use patchtrace::scene::generate::{SplitMix64, TEAPOT_BPT, TeapotsSpec, teapots_scene};
 use patchtrace::scene::{Geometry, Scene};
@@ -96,7 +97,7 @@ const POINT_ULPS: f64 = 64.0;
 fn trace_through_instances_hits_what_the_copies_hit_in_f64() {
     let (inst, flat) = both(40);
     let (gi, gf) = (SceneGeometry::build(&inst), SceneGeometry::build(&flat));
-    let f32_path = Precision::F32(SubdivisionConfig::default());
+    let f32_path = Kernel::F32(SubdivisionConfig::default());
     let cfg = SubdivisionConfig::default();
     let mut rng = SplitMix64::new(17);
     let b = gi.bounds();
@@ -289,7 +290,7 @@ fn mirrored_and_stretched_instances_report_the_copies_hits_and_normals() {
     let (gi, gf) = (SceneGeometry::build(&si), SceneGeometry::build(&sf));
     assert_eq!((gi.instance_count(), gi.prepared_patch_count()), (3, 1));
     let cfg = SubdivisionConfig::default();
-    let f32_path = Precision::F32(cfg);
+    let f32_path = Kernel::F32(cfg);
     let eye = si.camera.eye;
     let mut q = QueryStats::default();
     let mut hits = [0; 3];

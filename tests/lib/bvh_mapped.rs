@@ -15,10 +15,11 @@ use common::{render, run, stderr, testdata, trace_rows};
 use glam::Vec3;
 use patchtrace::accel::bvh::{Bvh, checksum};
 use patchtrace::accel::mapped;
-use patchtrace::accel::scene::{FromFile, Precision, QueryStats, SceneGeometry};
+use patchtrace::accel::scene::{FromFile, QueryStats, SceneGeometry};
 use patchtrace::formats::ron_format::parsed_scene;
 use patchtrace::formats::{LoadOptions, load_scene_keyed};
 use patchtrace::geom::{Aabb, Ray};
+use patchtrace::kernel::Kernel;
 use patchtrace::kernel::subdivision::SubdivisionConfig;
 
 /// Three teapots from one `.bpt` file, each placed by its own transform (so 96 distinct
@@ -235,7 +236,7 @@ fn truncated_and_damaged_files_are_refused_with_the_byte_offset() {
     // Random damage to the patch section, resealed: never a panic, and geometry from a
     // file that is accepted answers queries without one (in-process, so a panic fails).
     let mut rng = Rng::new(19);
-    let precision = Precision::F32(SubdivisionConfig::default());
+    let precision = Kernel::F32(SubdivisionConfig::default());
     let path = dir.path().join("forged.bvh");
     for _ in 0..40 {
         let mut bytes = good.clone();

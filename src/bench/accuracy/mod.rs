@@ -14,9 +14,10 @@ use std::time::Instant;
 use glam::DVec3;
 use serde::Serialize;
 
-use crate::accel::scene::{Precision, QueryStats, SceneGeometry, SceneHit};
+use crate::accel::scene::{QueryStats, SceneGeometry, SceneHit};
 use crate::formats::rays::RayQuery;
 use crate::geom::{DAabb, Ray};
+use crate::kernel::Kernel;
 use crate::kernel::cached::CachedConfig;
 use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig, Termination};
 use crate::kernel::toth::TothConfig;
@@ -80,11 +81,11 @@ impl Method {
 
     /// The kernel path of the method. `camera` sizes the pixels of adaptive termination;
     /// a tessellation has no patches left, so the default is as good as any.
-    pub fn precision(&self, camera: &Camera) -> Precision {
+    pub fn precision(&self, camera: &Camera) -> Kernel {
         let base = SubdivisionConfig::default();
-        Precision::F32(match *self {
-            Method::Toth => return Precision::Toth(TothConfig::default()),
-            Method::Cached => return Precision::Cached(CachedConfig::default()),
+        Kernel::F32(match *self {
+            Method::Toth => return Kernel::Toth(TothConfig::default()),
+            Method::Cached => return Kernel::Cached(CachedConfig::default()),
             Method::Float(heuristic) => SubdivisionConfig { heuristic, ..base },
             Method::Adaptive => SubdivisionConfig {
                 termination: Termination::Adaptive(CameraRays::new(camera).footprint()),
