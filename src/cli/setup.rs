@@ -32,14 +32,14 @@ pub fn precision(args: &KernelArgs, camera: &Camera) -> anyhow::Result<Kernel> {
             ("--cache-size", args.cache_size.is_some()),
             ("--cache-depth", args.cache_depth.is_some()),
         ] {
-            anyhow::ensure!(
+            ensure_arg!(
                 !given,
                 "{flag} sizes the surface-tree cache, which only --kernel cached has; add --kernel cached or drop {flag}"
             );
         }
     }
     if matches!(args.kernel, KernelChoice::Toth | KernelChoice::Cached) {
-        anyhow::ensure!(
+        ensure_arg!(
             args.precision == PrecisionChoice::F32,
             "--kernel toth and --kernel cached work on f32 rays and have no --precision f64 variant; use --kernel subdivision --precision f64 for the reference"
         );
@@ -57,7 +57,7 @@ pub fn precision(args: &KernelArgs, camera: &Camera) -> anyhow::Result<Kernel> {
             _ => Kernel::Toth(toth),
         });
     }
-    anyhow::ensure!(
+    ensure_arg!(
         !args.isrt,
         "--isrt applies to the Toth kernels only; add --kernel toth or --kernel cached"
     );
@@ -113,7 +113,7 @@ pub fn prepare(
     args: &KernelArgs,
     quiet: bool,
 ) -> anyhow::Result<Prepared> {
-    anyhow::ensure!(
+    ensure_arg!(
         args.accel == AccelChoice::Bvh || args.bvh.is_none(),
         "--bvh loads a BVH file, which --accel grid does not use; drop one of the two flags"
     );

@@ -71,14 +71,6 @@ impl Aabb {
         e.x + e.y + e.z
     }
 
-    pub fn surface_area(&self) -> f32 {
-        if self.is_empty() {
-            return 0.0;
-        }
-        let e = self.extent();
-        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
-    }
-
     pub fn contains(&self, p: Vec3) -> bool {
         p.cmpge(self.min).all() && p.cmple(self.max).all()
     }

@@ -185,3 +185,23 @@ fn effort_aov_counts_every_split_of_the_render() {
     assert_eq!(values[0], 0.0);
     assert!(dir.path().join("e-effort.png").exists());
 }
+
+/// A flag the command cannot honour is bad input: exit status 2, the flag named, no image.
+#[test]
+fn flags_the_command_cannot_honour_exit_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.png");
+    let scene = testdata("teapot.ron");
+    for (extra, named) in [
+        (&["--crop", "0,4000,0,10"][..], "--crop"),
+        (&["--tile", "3/2"][..], "tile"),
+        (&["--bvh", "absent.bvh", "--accel", "grid"][..], "--bvh"),
+        (&["--isrt"][..], "--isrt"),
+    ] {
+        let o = render(&scene, &out, (16, 16), extra);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {err}");
+        assert!(err.contains(named), "{extra:?}: {err}");
+        assert!(!out.exists(), "{extra:?} wrote an image");
+    }
+}
