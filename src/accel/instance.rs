@@ -198,10 +198,7 @@ fn to_daabb(b: &Aabb) -> DAabb {
     if b.is_empty() {
         return DAabb::EMPTY;
     }
-    DAabb {
-        min: b.min.as_dvec3(),
-        max: b.max.as_dvec3(),
-    }
+    b.to_f64()
 }
 
 /// The maximum absolute row sum of `m`: the operator norm for the ∞-norm.

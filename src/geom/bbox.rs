@@ -60,6 +60,14 @@ impl Aabb {
         self.max - self.min
     }
 
+    /// The same box in `f64` (exact: every `f32` is an `f64`).
+    pub fn to_f64(&self) -> DAabb {
+        DAabb {
+            min: self.min.as_dvec3(),
+            max: self.max.as_dvec3(),
+        }
+    }
+
     pub fn center(&self) -> Vec3 {
         (self.min + self.max) * 0.5
     }
@@ -304,10 +312,7 @@ mod tests {
         let d = Vec3::new(0.0, 1.0, 0.0);
         let (t0, _) = b.intersect(o, d.recip(), 0.0, f32::INFINITY).expect("hit");
         assert_eq!(t0, 7.0);
-        let db = DAabb {
-            min: b.min.as_dvec3(),
-            max: b.max.as_dvec3(),
-        };
+        let db = b.to_f64();
         let (t0, _) = db
             .intersect(o.as_dvec3(), d.as_dvec3().recip(), 0.0, f64::INFINITY)
             .expect("hit");

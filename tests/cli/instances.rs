@@ -100,11 +100,7 @@ fn trace_through_instances_hits_what_the_copies_hit_in_f64() {
     let f32_path = Kernel::F32(SubdivisionConfig::default());
     let cfg = SubdivisionConfig::default();
     let mut rng = SplitMix64::new(17);
-    let b = gi.bounds();
-    let bounds = DAabb {
-        min: b.min.as_dvec3(),
-        max: b.max.as_dvec3(),
-    };
+    let bounds = gi.bounds().to_f64();
     let mut q = QueryStats::default();
     let (mut hits, mut ties, mut disagree, mut shadow_disagree) = (0, 0, 0, 0);
     let mut worst = 0.0f64;

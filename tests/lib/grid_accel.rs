@@ -64,11 +64,7 @@ fn random_ray(rng: &mut SplitMix64, b: &DAabb) -> Ray {
 }
 
 fn scene_box(g: &SceneGeometry) -> DAabb {
-    let b = g.bounds();
-    DAabb {
-        min: b.min.as_dvec3(),
-        max: b.max.as_dvec3(),
-    }
+    g.bounds().to_f64()
 }
 
 #[test]

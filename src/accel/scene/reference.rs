@@ -3,7 +3,7 @@
 use glam::DVec3;
 
 use super::{QueryStats, SceneGeometry, SceneHit};
-use crate::geom::{DAabb, Ray};
+use crate::geom::Ray;
 use crate::kernel::subdivision::{self, SubdivisionConfig};
 use crate::kernel::triangle::{self, RayShear};
 
@@ -27,11 +27,7 @@ impl SceneGeometry {
         for placement in &self.instances {
             let limit = best.as_ref().map_or(tmax, |h| h.t);
             stats.bvh_box_tests += 1;
-            let b = &placement.bounds;
-            let b = DAabb {
-                min: b.min.as_dvec3(),
-                max: b.max.as_dvec3(),
-            };
+            let b = placement.bounds.to_f64();
             if b.intersect(origin, inv, tmin, limit).is_none() {
                 continue;
             }
@@ -60,12 +56,8 @@ impl SceneGeometry {
         let mut best: Option<(u32, subdivision::PatchHit64)> = None;
         let inv = dir.recip();
         for prim in 0..self.patches.len() {
-            let b = self.patches.bounds(prim);
+            let b = self.patches.bounds(prim).to_f64();
             stats.bvh_box_tests += 1;
-            let b = DAabb {
-                min: b.min.as_dvec3(),
-                max: b.max.as_dvec3(),
-            };
             let limit = best.as_ref().map_or(tmax, |(_, h)| h.t);
             if b.intersect(origin, inv, tmin, limit).is_none() {
                 continue;

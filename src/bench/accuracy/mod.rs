@@ -16,7 +16,7 @@ use serde::Serialize;
 
 use crate::accel::scene::{QueryStats, SceneGeometry, SceneHit};
 use crate::formats::rays::RayQuery;
-use crate::geom::{DAabb, Ray};
+use crate::geom::Ray;
 use crate::kernel::Kernel;
 use crate::kernel::cached::CachedConfig;
 use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig, Termination};
@@ -172,10 +172,7 @@ struct Reference {
 /// rounding bound. If the box rounds off the ray, the entry point is used.
 fn hit_point(h: &SceneHit, r: &Ray) -> DVec3 {
     let (origin, dir) = (r.origin.as_dvec3(), r.dir.as_dvec3());
-    let b = DAabb {
-        min: h.hit_box.min.as_dvec3(),
-        max: h.hit_box.max.as_dvec3(),
-    };
+    let b = h.hit_box.to_f64();
     let t = b
         .intersect(origin, dir.recip(), r.tmin as f64, f64::INFINITY)
         .map_or(h.t, |(t0, t1)| 0.5 * (t0 + t1));
