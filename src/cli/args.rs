@@ -156,8 +156,8 @@ pub struct TeapotsArgs {
 
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// Scene (.ron) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb, .igs, .iges, .step,
-    /// .stp). For IGES and STEP files also the units, what was not read (by type),
+    /// Scene (.ron) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb, .stl, .igs, .iges,
+    /// .step, .stp). For IGES and STEP files also the units, what was not read (by type),
     /// surfaces not converted, and the largest error of projected trim curves.
     pub scene: PathBuf,
     #[command(flatten)]
@@ -495,7 +495,8 @@ pub struct TessellateArgs {
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
-    /// Output mesh: .obj, .gltf (buffer embedded) or .glb.
+    /// Output mesh: .obj, .gltf (buffer embedded), .glb or .stl (binary, coordinates in
+    /// `f32`).
     #[arg(short, long)]
     pub output: PathBuf,
     /// Uniform grid per patch with this many triangles (an even number 2·u·v, e.g. 512,

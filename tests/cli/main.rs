@@ -24,6 +24,7 @@ mod lg6_cache_flags;
 mod man_pages;
 mod progress;
 mod render;
+mod stl;
 mod subdiv_cli;
 mod term_accuracy;
 mod tess_trimmed;
