@@ -37,11 +37,17 @@ use super::search::{end_game_diameter, search};
 use crate::geom::bbox::SLAB_FAR_SCALE;
 use crate::kernel::KernelStats;
 
-/// Whether this CPU runs the AVX-512 path (detected once and cached by the standard
-/// library).
+/// Whether this CPU runs the AVX-512 path: it has AVX-512F, and the environment does not
+/// set `PATCHTRACE_NO_AVX512` (to anything but `0`), which makes an AVX-512 machine
+/// render, trace and test as one without it does (the portable world-space search and
+/// bilinear patches as such), to check or measure that path. Decided once per process.
 #[inline(always)]
 pub fn available() -> bool {
-    is_x86_feature_detected!("avx512f")
+    static AVAILABLE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *AVAILABLE.get_or_init(|| {
+        let refused = std::env::var_os("PATCHTRACE_NO_AVX512").is_some_and(|v| v != "0");
+        is_x86_feature_detected!("avx512f") && !refused
+    })
 }
 
 /// A bicubic net, one row of points per register (see the module documentation).
