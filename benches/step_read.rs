@@ -41,7 +41,7 @@ fn main() {
             t.elapsed().as_secs_f64(),
             cpu_seconds().zip(c).map(|(a, b)| a - b),
         );
-        faces = model.report.faces;
+        faces = model.parts.iter().map(|p| p.pieces.len()).sum::<usize>();
         let t = Instant::now();
         let ex = records::parse(&text).unwrap();
         let dp = t.elapsed().as_secs_f64();

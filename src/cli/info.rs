@@ -11,6 +11,7 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
     let (scene, notes) = crate::progress::while_reading(args.quiet, &args.scene, || {
         load_scene_noted(&args.scene, args.mesh.load_options())
     })?;
+    crate::cli::setup::print_warnings(&scene);
     let s = summarize(&scene);
     let mut out = std::io::stdout().lock();
     if args.json {

@@ -102,7 +102,17 @@ pub struct Prepared {
 /// Reads the scene at `path` with `--subdivide`'s options, under a spinner when the file is
 /// large ([`while_reading`](crate::progress::while_reading)), unless `quiet`.
 pub fn load(path: &Path, mesh: &MeshArgs, quiet: bool) -> Result<Scene, crate::formats::LoadError> {
-    crate::progress::while_reading(quiet, path, || load_scene_with(path, mesh.load_options()))
+    let scene =
+        crate::progress::while_reading(quiet, path, || load_scene_with(path, mesh.load_options()))?;
+    print_warnings(&scene);
+    Ok(scene)
+}
+
+/// Prints what reading the scene's files left out or tolerated, once, on stderr.
+pub fn print_warnings(scene: &Scene) {
+    for w in &scene.warnings {
+        eprintln!("{w}");
+    }
 }
 
 /// Loads the scene and prepares its geometry: builds the BVH or loads `--bvh`, or builds
@@ -158,9 +168,11 @@ pub fn load_keyed(
     quiet: bool,
     (defer, parsed): (bool, Option<(u64, &[u8])>),
 ) -> Result<(Scene, u64), crate::formats::LoadError> {
-    crate::progress::while_reading(quiet, path, || {
+    let (scene, key) = crate::progress::while_reading(quiet, path, || {
         load_scene_keyed(path, mesh.load_options(), defer, parsed)
-    })
+    })?;
+    print_warnings(&scene);
+    Ok((scene, key))
 }
 
 /// [`prepare`] with `--bvh FILE`: the file is mapped, the scene read without its geometry

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use super::cad::{iges, step};
+use super::cad::{iges, scene, step};
 use super::error::LoadError;
 use super::{bpt, cage, gltf_mesh, mesh, obj, pbrt, ron_format};
 use crate::geom::bbox::DAabb;
@@ -46,9 +46,16 @@ fn unknown_kind(path: &Path) -> LoadError {
     )
 }
 
-/// Reads a geometry file: free-form surfaces or a triangle mesh.
+/// Reads a geometry file: free-form surfaces or a triangle mesh
+/// ([`load_geometry_noted`] also gives the warnings).
 pub fn load_geometry(path: &Path) -> Result<Geometry, LoadError> {
-    match InputKind::of(path).ok_or_else(|| unknown_kind(path))? {
+    Ok(load_geometry_noted(path)?.0)
+}
+
+/// [`load_geometry`] and the warning lines reading the file gave, for the command line to
+/// print.
+pub fn load_geometry_noted(path: &Path) -> Result<(Geometry, Vec<String>), LoadError> {
+    let geometry = match InputKind::of(path).ok_or_else(|| unknown_kind(path))? {
         InputKind::Bpt => Ok(Geometry::Surfaces(
             bpt::read_bpt(path)?
                 .into_iter()
@@ -76,12 +83,13 @@ pub fn load_geometry(path: &Path) -> Result<Geometry, LoadError> {
                 .map(|d| d.surface)
                 .collect(),
         )),
-        InputKind::Step => step::load_geometry(path),
+        InputKind::Step => return scene::build_geometry(path, step::read_step(path)?),
         InputKind::Ron => Err(LoadError::invalid(
             path,
             "a scene cannot be used as geometry; reference its geometry files instead",
         )),
-    }
+    }?;
+    Ok((geometry, Vec::new()))
 }
 
 /// The up axis a format's convention gives bare geometry: y for glTF (glTF 2.0 §3.4, "glTF
@@ -216,13 +224,8 @@ pub fn load_scene_noted(
         }
         (bare_scene(path, load_subdivision(path)?), Vec::new())
     } else if InputKind::of(path) == Some(InputKind::Step) {
-        let model = step::read_step(path)?;
-        if let Some(w) = model.report.warning(path) {
-            eprintln!("{w}");
-        }
-        let mut scene = Scene::framing(model.objects);
-        scene.materials = model.materials;
-        (scene, model.report.lines())
+        let read = scene::build_scene(path, step::read_step(path)?)?;
+        (read.scene, read.notes)
     } else {
         (read_any_scene(path)?, Vec::new())
     };

@@ -387,6 +387,7 @@ fn build_scene(
     // 10,000 copies of one teapot read and parsed it 10,000 times).
     let mut files: std::collections::HashMap<std::path::PathBuf, Geometry> =
         std::collections::HashMap::new();
+    let mut warnings = Vec::new();
     for (index, o) in file.objects.iter().enumerate() {
         let material = match &o.material {
             Some(name) => materials.iter().position(|m| &m.name == name).ok_or_else(|| {
@@ -430,8 +431,9 @@ fn build_scene(
                 match files.get(&path) {
                     Some(g) => g.clone(),
                     None => {
-                        let g = super::load::load_geometry(&path)
+                        let (g, noted) = super::load::load_geometry_noted(&path)
                             .map_err(|e| referenced(at, index, f, e))?;
+                        warnings.extend(noted);
                         files.insert(path, g.clone());
                         g
                     }
@@ -535,6 +537,7 @@ fn build_scene(
         materials,
         objects,
         unread_bounds: None,
+        warnings,
     })
 }
 

@@ -87,6 +87,7 @@ impl BareShell {
                 min: DVec3::from_array(shell.bounds[0]),
                 max: DVec3::from_array(shell.bounds[1]),
             }),
+            warnings: Vec::new(),
         })
     }
 }

@@ -462,6 +462,9 @@ pub struct Scene {
     /// ([`crate::scene::bare_shell`]), the bounds of that geometry, which framing uses;
     /// `None`: the objects' own.
     pub unread_bounds: Option<DAabb>,
+    /// What reading the scene's files left out or tolerated, one line each, for the
+    /// command line to print (the library prints nothing).
+    pub warnings: Vec<String>,
 }
 
 /// Default recursion limit for reflection and refraction.
@@ -505,6 +508,7 @@ impl Scene {
             materials: vec![Material::default_named("default")],
             objects,
             unread_bounds: None,
+            warnings: Vec::new(),
         };
         scene.frame_bare(up);
         scene

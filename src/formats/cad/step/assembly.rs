@@ -1,14 +1,22 @@
 //! Product structure (AP214/AP242 assemblies, ISO 10303-44 §4.?): which shape
-//! representations hold geometry, and where each component sits. A component's
-//! representation is tied to its assembly's by a REPRESENTATION_RELATIONSHIP_WITH_
-//! TRANSFORMATION whose ITEM_DEFINED_TRANSFORMATION maps placement `item_1` (in the
-//! component, `rep_1`) onto `item_2` (in the assembly, `rep_2`); the
-//! CONTEXT_DEPENDENT_SHAPE_REPRESENTATION naming the NEXT_ASSEMBLY_USAGE_OCCURRENCE ties it
-//! to the product tree but adds no geometry. Plain SHAPE_REPRESENTATION_RELATIONSHIPs join a
-//! part's representations (its placements and its B-rep).
+//! representations hold geometry, and where each component sits.
 //!
-//! The scene model has no instances yet, so every occurrence is flattened into a
-//! transformed copy of the component's geometry; the reader says how many.
+//! A component's representation is tied to its assembly's by a REPRESENTATION_RELATIONSHIP_
+//! WITH_TRANSFORMATION whose ITEM_DEFINED_TRANSFORMATION places `transform_item_1` (an item
+//! of `rep_1`) onto `transform_item_2` (an item of `rep_2`) (ISO 10303-43 §4.4.?): the map
+//! from `rep_1`'s coordinates to `rep_2`'s is frame(item_2) · frame(item_1)⁻¹. Which side is
+//! the component is not fixed by the relationship: the CONTEXT_DEPENDENT_SHAPE_REPRESENTATION
+//! naming it names the NEXT_ASSEMBLY_USAGE_OCCURRENCE (through its PRODUCT_DEFINITION_SHAPE),
+//! whose `related_product_definition` is the component; its SHAPE_DEFINITION_REPRESENTATION
+//! gives the component's representation. Most writers put the component in `rep_1`;
+//! SolidWorks puts the assembly there, and the map is then taken the other way (as
+//! OpenCASCADE's `STEPConstruct_Assembly::CheckSRRReversesNAUO` does).
+//!
+//! A MAPPED_ITEM places its REPRESENTATION_MAP's `mapped_representation` so that the map's
+//! `mapping_origin` lands on the item's `mapping_target` (ISO 10303-43 §4.4.?): a child
+//! placed by frame(target) · frame(origin)⁻¹ in the representation holding the item.
+//! Plain SHAPE_REPRESENTATION_RELATIONSHIPs join a part's representations (its placements
+//! and its B-rep) into one part.
 
 use std::collections::HashMap;
 
@@ -48,8 +56,10 @@ pub const GEOMETRY_ITEMS: [&str; 7] = [
     "FACE_SURFACE",
 ];
 
-/// Items that carry no geometry of their own (placements, presentation).
-const NON_GEOMETRY_ITEMS: [&str; 4] = [
+/// Items that carry no geometry of their own (placements, presentation), or that place
+/// another representation (MAPPED_ITEM, followed as a link).
+const NON_GEOMETRY_ITEMS: [&str; 5] = [
+    "MAPPED_ITEM",
     "AXIS2_PLACEMENT_3D",
     "STYLED_ITEM",
     "CARTESIAN_POINT",
@@ -70,6 +80,8 @@ pub fn occurrences(
 ) -> Result<Vec<Occurrence>, ParseError> {
     // Representations with their items and contexts.
     let mut reps: HashMap<u64, (Vec<u64>, Option<u64>)> = HashMap::new();
+    // The representation holding each item (for MAPPED_ITEMs).
+    let mut item_owner: HashMap<u64, u64> = HashMap::new();
     for inst in &res.ex.instances {
         let Some(r) = inst
             .records
@@ -90,6 +102,7 @@ pub fn occurrences(
                     "references #{id}, which is not defined in the file"
                 )));
             };
+            item_owner.entry(id).or_insert(inst.id);
             let name = item.records[0].name;
             if GEOMETRY_ITEMS.contains(&name) {
                 items.push(id);
@@ -105,6 +118,7 @@ pub fn occurrences(
         };
         reps.insert(inst.id, (items, context));
     }
+    let components = Components::of(res);
     // Links between representations.
     let mut links = Vec::new();
     for inst in &res.ex.instances {
@@ -122,8 +136,8 @@ pub fn occurrences(
             inst,
             rec: r,
         };
-        let child = rec.reference(2, "rep_1")?;
-        let parent = rec.reference(3, "rep_2")?;
+        let rep_1 = rec.reference(2, "rep_1")?;
+        let rep_2 = rec.reference(3, "rep_2")?;
         let transform = match inst.record("REPRESENTATION_RELATIONSHIP_WITH_TRANSFORMATION") {
             Some(t) => {
                 let trec = Rec {
@@ -137,16 +151,43 @@ pub fn occurrences(
                     *unsupported.entry(idt.type_name().into_owned()).or_default() += 1;
                     continue;
                 };
-                let from = res.frame(&ir, 2)?.to_affine();
-                let to = res.frame(&ir, 3)?.to_affine();
-                Some(to * from.inverse())
+                let item_1 = res.frame(&ir, 2)?.to_affine();
+                let item_2 = res.frame(&ir, 3)?.to_affine();
+                Some(item_2 * item_1.inverse())
             }
             None => None,
         };
+        // rep_1 → rep_2 as written; reversed when the NAUO says rep_2 is the component.
+        let link = match transform {
+            Some(t) if components.reversed(inst.id, rep_1, rep_2) => Link {
+                child: rep_2,
+                parent: rep_1,
+                transform: Some(t.inverse()),
+            },
+            _ => Link {
+                child: rep_1,
+                parent: rep_2,
+                transform,
+            },
+        };
+        links.push(link);
+    }
+    for inst in &res.ex.instances {
+        let Some(r) = res.named(inst, "MAPPED_ITEM") else {
+            continue;
+        };
+        let Some(&parent) = item_owner.get(&inst.id) else {
+            continue;
+        };
+        let map = res.instance(&r, r.reference(1, "a REPRESENTATION_MAP")?)?;
+        let m = res.rec(map);
+        let origin = res.frame(&m, 0)?.to_affine();
+        let child = m.reference(1, "the mapped representation")?;
+        let target = res.frame(&r, 2)?.to_affine();
         links.push(Link {
             child,
             parent,
-            transform,
+            transform: Some(target * origin.inverse()),
         });
     }
     // Representations joined without a transformation are one part.
@@ -233,4 +274,76 @@ pub fn occurrences(
         }
     }
     Ok(out)
+}
+
+/// Which representations belong to the component of each assembly relationship: the
+/// relationship's CONTEXT_DEPENDENT_SHAPE_REPRESENTATION → PRODUCT_DEFINITION_SHAPE →
+/// NEXT_ASSEMBLY_USAGE_OCCURRENCE (relating: the assembly, related: the component), and
+/// each product definition's representations by SHAPE_DEFINITION_REPRESENTATION.
+struct Components {
+    /// Relationship id → (assembly, component) product definitions.
+    usage: HashMap<u64, (u64, u64)>,
+    /// Product definition → its shape representations.
+    reps: HashMap<u64, Vec<u64>>,
+}
+
+impl Components {
+    fn of(res: &Resolver) -> Components {
+        let ex = res.ex;
+        let refs = |inst: &crate::formats::cad::step::records::Instance, name: &str| {
+            let r = inst.record(name)?;
+            let ids: Vec<Option<u64>> = r
+                .params
+                .iter()
+                .map(|p| match p.value {
+                    Value::Ref(id) => Some(id),
+                    _ => None,
+                })
+                .collect();
+            Some(ids)
+        };
+        // PRODUCT_DEFINITION_SHAPE → what it defines (a product definition or a NAUO).
+        let mut defines: HashMap<u64, u64> = HashMap::new();
+        let mut usage = HashMap::new();
+        let mut reps: HashMap<u64, Vec<u64>> = HashMap::new();
+        for inst in &ex.instances {
+            if let Some(p) = refs(inst, "PRODUCT_DEFINITION_SHAPE")
+                && let Some(Some(d)) = p.get(2)
+            {
+                defines.insert(inst.id, *d);
+            }
+        }
+        for inst in &ex.instances {
+            if let Some(p) = refs(inst, "SHAPE_DEFINITION_REPRESENTATION")
+                && let (Some(Some(pds)), Some(Some(rep))) = (p.first(), p.get(1))
+                && let Some(&pd) = defines.get(pds)
+            {
+                reps.entry(pd).or_default().push(*rep);
+            }
+            if let Some(p) = refs(inst, "CONTEXT_DEPENDENT_SHAPE_REPRESENTATION")
+                && let (Some(Some(rel)), Some(Some(pds))) = (p.first(), p.get(1))
+                && let Some(nauo) = defines.get(pds).and_then(|&n| ex.get(n))
+                && let Some(n) = nauo
+                    .records
+                    .iter()
+                    .find(|r| r.name.ends_with("ASSEMBLY_USAGE_OCCURRENCE"))
+                && let (Some(Value::Ref(a)), Some(Value::Ref(c))) = (
+                    n.params.get(3).map(|p| &p.value),
+                    n.params.get(4).map(|p| &p.value),
+                )
+            {
+                usage.insert(*rel, (*a, *c));
+            }
+        }
+        Components { usage, reps }
+    }
+
+    /// Whether relationship `rel` between `rep_1` and `rep_2` has its component in `rep_2`.
+    fn reversed(&self, rel: u64, rep_1: u64, rep_2: u64) -> bool {
+        let Some(&(assembly, component)) = self.usage.get(&rel) else {
+            return false;
+        };
+        let holds = |pd: u64, rep: u64| self.reps.get(&pd).is_some_and(|r| r.contains(&rep));
+        !holds(component, rep_1) && (holds(component, rep_2) || holds(assembly, rep_1))
+    }
 }

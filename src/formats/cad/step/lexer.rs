@@ -55,6 +55,11 @@ pub struct Lexer<'a> {
     /// only the bytes since the previous one: counting from the line start every time
     /// was quadratic in the length of a line, and writers put whole control nets on one.
     last_column: std::cell::Cell<(usize, u32)>,
+    /// Backslashes inside strings that begin no escape of ISO 10303-21 §6.4.3 (Windows paths
+    /// written with single backslashes), kept as text: how many, and the first one's
+    /// position and text.
+    pub literal_backslashes: usize,
+    pub first_literal: Option<(u32, u32, String)>,
 }
 
 impl<'a> Lexer<'a> {
@@ -65,6 +70,8 @@ impl<'a> Lexer<'a> {
             line: 1,
             line_start: 0,
             last_column: std::cell::Cell::new((0, 1)),
+            literal_backslashes: 0,
+            first_literal: None,
         }
     }
 
@@ -255,7 +262,14 @@ impl<'a> Lexer<'a> {
         if plain {
             return Ok((TokenKind::Str(Cow::Borrowed(raw)), end));
         }
-        let decoded = decode_string(raw).map_err(|m| self.error(start, m))?;
+        let (decoded, literal) = decode_string(raw);
+        if let Some(what) = literal.first() {
+            if self.first_literal.is_none() {
+                let (line, column) = (self.line, self.column_of(start));
+                self.first_literal = Some((line, column, what.clone()));
+            }
+            self.literal_backslashes += literal.len();
+        }
         self.bump_newlines(start, end);
         Ok((TokenKind::Str(Cow::Owned(decoded)), end))
     }
@@ -293,8 +307,12 @@ fn hex_chars(hex: &str, width: usize) -> Result<String, String> {
 /// Decodes the body of a string: `''`, `\\`, `\X\hh` (ISO 8859-1), `\X2\…\X0\` (UCS-2),
 /// `\X4\…\X0\` (UCS-4), `\S\c` (the upper half of the code page); `\Px\` page switches
 /// are dropped (the text is taken as ISO 8859-1); line breaks inside strings are ignored.
-fn decode_string(raw: &str) -> Result<String, String> {
+/// A backslash that begins no well-formed control directive of ISO 10303-21 §6.4.3 (a
+/// Windows path written with single backslashes: `C:\TEMP\part.stp`) is kept as text, as
+/// OpenCASCADE reads it; the text of each such escape is returned beside the string.
+fn decode_string(raw: &str) -> (String, Vec<String>) {
     let mut out = String::with_capacity(raw.len());
+    let mut literal = Vec::new();
     let mut rest = raw;
     while let Some(c) = rest.chars().next() {
         if c == '\'' {
@@ -303,43 +321,51 @@ fn decode_string(raw: &str) -> Result<String, String> {
         } else if c == '\n' || c == '\r' {
             rest = &rest[1..];
         } else if c == '\\' {
-            let tail = &rest[1..];
-            if let Some(t) = tail.strip_prefix('\\') {
-                out.push('\\');
-                rest = t;
-            } else if let Some(t) = tail.strip_prefix("X\\") {
-                let hex = t.get(..2).ok_or("expected two hex digits after `\\X\\`")?;
-                out.push_str(&hex_chars(hex, 2)?);
-                rest = &t[2..];
-            } else if let Some(t) = tail.strip_prefix("X2\\").or(tail.strip_prefix("X4\\")) {
-                let width = if tail.starts_with("X2") { 4 } else { 8 };
-                let close = t
-                    .find("\\X0\\")
-                    .ok_or("expected `\\X0\\` ending the escape")?;
-                out.push_str(&hex_chars(&t[..close], width)?);
-                rest = &t[close + 4..];
-            } else if let Some(t) = tail.strip_prefix("S\\") {
-                let ch = t
-                    .chars()
-                    .next()
-                    .ok_or("expected a character after `\\S\\`")?;
-                let code = ch as u32 + 128;
-                out.push(char::from_u32(code).ok_or("bad `\\S\\` character")?);
-                rest = &t[ch.len_utf8()..];
-            } else if tail.len() >= 3 && tail.starts_with('P') && tail.as_bytes()[2] == b'\\' {
-                rest = &tail[3..];
-            } else {
-                return Err(format!(
-                    "unknown escape `\\{}`",
-                    tail.get(..2).unwrap_or(tail)
-                ));
+            match control_directive(&rest[1..]) {
+                Some((text, t)) => {
+                    out.push_str(&text);
+                    rest = t;
+                }
+                None => {
+                    let tail = &rest[1..];
+                    let shown: String = tail.chars().take(2).collect();
+                    literal.push(format!("\\{shown}"));
+                    out.push('\\');
+                    rest = tail;
+                }
             }
         } else {
             out.push(c);
             rest = &rest[c.len_utf8()..];
         }
     }
-    Ok(out)
+    (out, literal)
+}
+
+/// The text of the control directive that `tail` (what follows a backslash) begins, and
+/// what follows it; `None` when it begins none, or a malformed one.
+fn control_directive(tail: &str) -> Option<(String, &str)> {
+    if let Some(t) = tail.strip_prefix('\\') {
+        return Some(("\\".into(), t));
+    }
+    if let Some(t) = tail.strip_prefix("X\\") {
+        let hex = t.get(..2)?;
+        return Some((hex_chars(hex, 2).ok()?, &t[2..]));
+    }
+    if let Some(t) = tail.strip_prefix("X2\\").or(tail.strip_prefix("X4\\")) {
+        let width = if tail.starts_with("X2") { 4 } else { 8 };
+        let close = t.find("\\X0\\")?;
+        return Some((hex_chars(&t[..close], width).ok()?, &t[close + 4..]));
+    }
+    if let Some(t) = tail.strip_prefix("S\\") {
+        let ch = t.chars().next()?;
+        let code = char::from_u32(ch as u32 + 128)?;
+        return Some((code.to_string(), &t[ch.len_utf8()..]));
+    }
+    if tail.len() >= 3 && tail.starts_with('P') && tail.as_bytes()[2] == b'\\' {
+        return Some((String::new(), &tail[3..]));
+    }
+    None
 }
 
 #[cfg(test)]
@@ -391,6 +417,9 @@ mod tests {
             ("'\\X4\\0001F600\\X0\\'", "😀"),
             ("'a\\\\b'", "a\\b"),
             ("'\\PA\\x\\S\\a'", "xá"),
+            // Not control directives (§6.4.3): kept as text.
+            ("'C:\\TEMP\\a.stp'", "C:\\TEMP\\a.stp"),
+            ("'\\X\\zz'", "\\X\\zz"),
         ];
         for (src, want) in cases {
             assert_eq!(
@@ -446,8 +475,11 @@ mod tests {
         assert!(e.message.contains("never closed"));
         let e = Lexer::new("  1e").next_token().unwrap_err();
         assert_eq!(e.column, 3);
-        assert!(Lexer::new("'\\X\\G0'").next_token().is_err());
-        assert!(Lexer::new("'\\X2\\00E9'").next_token().is_err());
+        // Malformed escapes are text (§6.4.3 directives only), counted for one warning.
+        let mut lx = Lexer::new("'\\X\\G0' '\\X2\\00E9'");
+        assert!(lx.next_token().unwrap().is_some() && lx.next_token().unwrap().is_some());
+        assert_eq!(lx.literal_backslashes, 4);
+        assert_eq!(lx.first_literal, Some((1, 1, "\\X\\".into())));
         assert!(Lexer::new("@").next_token().is_err());
     }
 }

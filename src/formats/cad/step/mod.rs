@@ -10,8 +10,9 @@
 //!
 //! Malformed files (syntax, wrong parameter kinds, dangling references) are errors located
 //! at `file.step:LINE:COL: #id ENTITY: …`. Entities that are valid but that the reader does
-//! not convert are counted by type, and faces that cannot be converted are named by `#id`,
-//! in the [`Report`] that `info` prints and in one warning line on stderr.
+//! not convert are counted by type, and faces that cannot be converted are named by `#id`;
+//! the [CAD front door](crate::formats::cad::scene) turns what was read into the scene, the
+//! lines `info` prints and one warning line.
 
 pub mod assembly;
 pub mod entities;
@@ -24,7 +25,6 @@ pub mod units;
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::Path;
-use std::sync::Arc;
 
 use glam::{DAffine3, DVec3};
 use rayon::prelude::*;
@@ -32,8 +32,9 @@ use rayon::prelude::*;
 use self::entities::Resolver;
 use self::style::Colour;
 use self::units::Units;
+use super::scene::{self, CadModel, DeclaredUnit, Failure, Part, Piece, Shape};
 use crate::formats::error::{LoadError, ParseError};
-use crate::scene::model::{Geometry, Instance, Material, Object, Surface};
+use crate::scene::model::{Material, Object, Surface};
 
 /// What reading a STEP file found beyond the geometry.
 #[derive(Clone, Debug, Default)]
@@ -49,16 +50,16 @@ pub struct Report {
     /// distance between such an edge and its trim, in millimetres.
     pub projected_edges: usize,
     pub max_projection_error: f64,
-    /// Shape occurrences flattened into transformed copies (the scene model has no
-    /// instances yet); 1 for a single part.
+    /// Placed occurrences of shape representations; 1 for a single part.
     pub occurrences: usize,
     pub colours: usize,
 }
 
 impl Report {
-    /// One line per fact, for `info`.
+    /// One line per fact, for `info` (what was skipped and failed is added by the
+    /// [CAD front door](crate::formats::cad::scene)).
     pub fn lines(&self) -> Vec<String> {
-        let mut out = vec![
+        vec![
             format!(
                 "STEP schema: {}",
                 if self.schemas.is_empty() {
@@ -75,66 +76,22 @@ impl Report {
                 self.units.angle.factor
             ),
             format!(
-                "faces: {} converted, {} failed; {} shape occurrence(s){}; {} colour(s)",
+                "faces: {} converted, {} failed; {} shape occurrence(s); {} colour(s)",
                 self.faces,
                 self.failed_faces.len(),
                 self.occurrences,
-                if self.occurrences > 1 {
-                    " flattened into transformed copies"
-                } else {
-                    ""
-                },
                 self.colours
             ),
             format!(
                 "projected edges: {}, largest projection error {:.3e} mm",
                 self.projected_edges, self.max_projection_error
             ),
-        ];
-        if !self.unsupported.is_empty() {
-            out.push(format!("unsupported entities: {}", self.unsupported_list()));
-        }
-        for (id, why) in &self.failed_faces {
-            out.push(format!("face #{id} not converted: {why}"));
-        }
-        out
-    }
-
-    fn unsupported_list(&self) -> String {
-        self.unsupported
-            .iter()
-            .map(|(t, n)| format!("{t} x{n}"))
-            .collect::<Vec<_>>()
-            .join(", ")
-    }
-
-    /// The one warning line for stderr, if anything was left out.
-    pub fn warning(&self, path: &Path) -> Option<String> {
-        if self.unsupported.is_empty() && self.failed_faces.is_empty() {
-            return None;
-        }
-        let mut parts = Vec::new();
-        if !self.failed_faces.is_empty() {
-            let ids: Vec<String> = self
-                .failed_faces
-                .iter()
-                .map(|(id, _)| format!("#{id}"))
-                .collect();
-            parts.push(format!(
-                "{} face(s) not converted ({})",
-                ids.len(),
-                ids.join(" ")
-            ));
-        }
-        if !self.unsupported.is_empty() {
-            parts.push(format!("unsupported entities: {}", self.unsupported_list()));
-        }
-        Some(format!("warning: {}: {}", path.display(), parts.join("; ")))
+        ]
     }
 }
 
-/// A STEP file read: objects (one per shape occurrence and colour), their materials
-/// (index 0 is the default), and the report.
+/// A STEP file read and assembled: objects (one per shape occurrence and colour) in
+/// millimetres, their materials (index 0 is the default), and the report.
 pub struct StepModel {
     pub objects: Vec<Object>,
     pub materials: Vec<Material>,
@@ -184,8 +141,8 @@ fn item_faces(
     Ok(())
 }
 
-/// Reads a STEP file into objects, materials and a report.
-pub fn read_step(path: &Path) -> Result<StepModel, LoadError> {
+/// Reads a STEP file for the [CAD front door](crate::formats::cad::scene).
+pub fn read_step(path: &Path) -> Result<CadModel, LoadError> {
     let bytes = std::fs::read(path).map_err(|e| LoadError::io(path, e))?;
     // Part 21 text is ISO 8859-1 outside strings' escapes; bytes above 127 (seen in
     // comments and names) are taken as Latin-1 rather than refused.
@@ -193,11 +150,95 @@ pub fn read_step(path: &Path) -> Result<StepModel, LoadError> {
         Ok(s) => s,
         Err(e) => e.into_bytes().iter().map(|&b| b as char).collect(),
     };
-    Ok(read_step_str(path, &src)?)
+    Ok(read_model(path, &src)?.0)
 }
 
-/// [`read_step`] on text already in memory; `path` names the file in errors.
+/// [`read_step`] on text already in memory, assembled as the front door assembles it;
+/// `path` names the file in errors.
 pub fn read_step_str(path: &Path, src: &str) -> Result<StepModel, ParseError> {
+    let (model, report) = read_model(path, src)?;
+    let stem = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let a = scene::assemble(&model, &stem);
+    Ok(StepModel {
+        objects: a.objects,
+        materials: a.materials,
+        report,
+    })
+}
+
+/// The model's size, for tolerances: the diagonal of the bounding box of every Cartesian
+/// point (1 when there are none).
+fn model_size(ex: &records::Exchange) -> f64 {
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for inst in &ex.instances {
+        let r = &inst.records[0];
+        if r.name == "CARTESIAN_POINT"
+            && let Some(records::Value::List(c)) = r.params.get(1).map(|p| &p.value)
+        {
+            let v: Vec<f64> = c
+                .iter()
+                .filter_map(|p| match p.value {
+                    records::Value::Real(x) => Some(x),
+                    records::Value::Integer(i) => Some(i as f64),
+                    _ => None,
+                })
+                .collect();
+            if v.len() == 3 {
+                let p = DVec3::new(v[0], v[1], v[2]);
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+    }
+    if lo.x <= hi.x {
+        (hi - lo).length().max(f64::MIN_POSITIVE)
+    } else {
+        1.0
+    }
+}
+
+/// What the file's shape representations hold, by item type, for the error when nothing
+/// in it is renderable.
+fn held(ex: &records::Exchange, faces: usize) -> String {
+    let mut items: BTreeMap<String, usize> = BTreeMap::new();
+    let mut seen: HashSet<u64> = HashSet::new();
+    for inst in &ex.instances {
+        let Some(r) = inst
+            .records
+            .iter()
+            .find(|r| r.name.ends_with("SHAPE_REPRESENTATION") && r.params.len() >= 3)
+        else {
+            continue;
+        };
+        let Some(records::Value::List(list)) = r.params.get(1).map(|p| &p.value) else {
+            continue;
+        };
+        for p in list {
+            if let records::Value::Ref(id) = p.value
+                && seen.insert(id)
+                && let Some(item) = ex.get(id)
+            {
+                *items.entry(item.type_name().into_owned()).or_default() += 1;
+            }
+        }
+    }
+    let listed: Vec<String> = items.iter().map(|(t, n)| format!("{t} x{n}")).collect();
+    format!(
+        "{faces} face(s); shape representation items: {}",
+        if listed.is_empty() {
+            "none".to_string()
+        } else {
+            listed.join(", ")
+        }
+    )
+}
+
+/// Reads the exchange structure `src` into the front door's model and the STEP report.
+pub fn read_model(path: &Path, src: &str) -> Result<(CadModel, Report), ParseError> {
     let ex = records::parse(src).map_err(|e| located(path, e))?;
     let mut res = Resolver::new(&ex, path);
     let mut report = Report {
@@ -227,35 +268,7 @@ pub fn read_step_str(path: &Path, src: &str) -> Result<StepModel, ParseError> {
     }
     report.occurrences = occurrences.len();
     let colours = style::colours(&ex);
-    let scale = DAffine3::from_scale(DVec3::splat(report.units.length.factor));
-    // The model's size, for tolerances: the bounding box of every Cartesian point.
-    let mut lo = DVec3::splat(f64::INFINITY);
-    let mut hi = DVec3::splat(f64::NEG_INFINITY);
-    for inst in &ex.instances {
-        let r = &inst.records[0];
-        if r.name == "CARTESIAN_POINT"
-            && let Some(records::Value::List(c)) = r.params.get(1).map(|p| &p.value)
-        {
-            let v: Vec<f64> = c
-                .iter()
-                .filter_map(|p| match p.value {
-                    records::Value::Real(x) => Some(x),
-                    records::Value::Integer(i) => Some(i as f64),
-                    _ => None,
-                })
-                .collect();
-            if v.len() == 3 {
-                let p = DVec3::new(v[0], v[1], v[2]);
-                lo = lo.min(p);
-                hi = hi.max(p);
-            }
-        }
-    }
-    let size = if lo.x <= hi.x {
-        (hi - lo).length().max(f64::MIN_POSITIVE)
-    } else {
-        1.0
-    };
+    let size = model_size(&ex);
     // Faces resolved once, in file order (the resolver's caches are not shared), then
     // converted on every core (each face on its own), then placed per occurrence.
     let mut placed: Vec<Vec<(u64, Option<Colour>)>> = Vec::with_capacity(occurrences.len());
@@ -290,105 +303,62 @@ pub fn read_step_str(path: &Path, src: &str) -> Result<StepModel, ParseError> {
             Err(why) => report.failed_faces.push((fid, why)),
         }
     }
-    let mut palette: Vec<Colour> = Vec::new();
-    // Per occurrence and material, the surfaces in their representation's own frame.
-    let mut groups: BTreeMap<(usize, usize), Vec<Surface>> = BTreeMap::new();
-    for (k, faces) in placed.into_iter().enumerate() {
-        for (fid, colour) in faces {
-            let Some(surface) = converted.get(&fid) else {
-                continue;
-            };
-            let material = match colour {
-                Some(c) => {
-                    1 + palette.iter().position(|p| *p == c).unwrap_or_else(|| {
-                        palette.push(c);
-                        palette.len() - 1
-                    })
-                }
-                None => 0,
-            };
-            groups
-                .entry((k, material))
-                .or_default()
-                .push(surface.clone());
-        }
-    }
-    let geometries = placed_geometries(&occurrences, groups, scale);
     report.faces = converted.len();
     report.failed_faces.sort_by_key(|(id, _)| *id);
     report.max_projection_error *= report.units.length.factor;
-    report.unsupported = unsupported;
-    report.colours = palette.len();
-    let mut materials = vec![Material::default_named("default")];
-    for c in &palette {
-        let mut m =
-            Material::default_named(&format!("rgb({:.3},{:.3},{:.3})", c.0.x, c.0.y, c.0.z));
-        m.diffuse = c.0;
-        materials.push(m);
+    let mut model = CadModel::new(
+        "STEP",
+        "face",
+        DeclaredUnit {
+            name: report.units.length.name.clone(),
+            millimetres: report.units.length.factor,
+        },
+    );
+    // One part per representation, however many occurrences place it.
+    let mut part_of: HashMap<u64, usize> = HashMap::new();
+    let mut palette: Vec<Colour> = Vec::new();
+    for (occ, faces) in occurrences.iter().zip(placed) {
+        let part = *part_of.entry(occ.representation).or_insert_with(|| {
+            model.parts.push(Part {
+                name: format!("#{}", occ.representation),
+                pieces: faces
+                    .iter()
+                    .filter_map(|(fid, colour)| {
+                        let surface = converted.get(fid)?;
+                        if let Some(c) = colour
+                            && !palette.contains(c)
+                        {
+                            palette.push(*c);
+                        }
+                        Some(Piece {
+                            shape: Shape::Surface(surface.clone()),
+                            colour: colour.map(|c| c.0),
+                        })
+                    })
+                    .collect(),
+            });
+            model.parts.len() - 1
+        });
+        model.occurrences.push(scene::Occurrence {
+            part,
+            transform: occ.transform,
+        });
     }
-    let stem = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let objects = geometries
-        .into_iter()
-        .map(|((k, material), geometry)| {
-            let occ = &occurrences[k];
-            Object {
-                name: if occurrences.len() > 1 || material > 0 {
-                    format!(
-                        "{stem} #{} occurrence {} {}",
-                        occ.representation,
-                        k + 1,
-                        materials[material].name
-                    )
-                } else {
-                    stem.clone()
-                },
-                material,
-                geometry,
-            }
+    report.colours = palette.len();
+    report.unsupported = unsupported;
+    model.held = held(&ex, seen.len());
+    model.warnings = ex.warnings.clone();
+    model.notes = report.lines();
+    model.skipped = report.unsupported.clone();
+    model.failures = report
+        .failed_faces
+        .iter()
+        .map(|(id, why)| Failure {
+            entity: format!("#{id}"),
+            why: why.clone(),
         })
         .collect();
-    Ok(StepModel {
-        objects,
-        materials,
-        report,
-    })
-}
-
-/// Each occurrence's surfaces placed in the model by `scale` after the occurrence's
-/// transform. A part that occurs once is a placed copy; the occurrences of a part used more
-/// than once are instances of one geometry in the part's frame (Dammertz §3.3), so it is
-/// prepared, and its BVH built, once however often the assembly uses it.
-fn placed_geometries(
-    occurrences: &[assembly::Occurrence],
-    groups: BTreeMap<(usize, usize), Vec<Surface>>,
-    scale: DAffine3,
-) -> BTreeMap<(usize, usize), Geometry> {
-    let mut uses: HashMap<u64, usize> = HashMap::new();
-    for occ in occurrences {
-        *uses.entry(occ.representation).or_default() += 1;
-    }
-    let mut shared: HashMap<(u64, usize), Arc<Geometry>> = HashMap::new();
-    groups
-        .into_iter()
-        .map(|((k, material), surfaces)| {
-            let occ = &occurrences[k];
-            let placement = scale * occ.transform;
-            let geometry = if uses[&occ.representation] > 1 {
-                let part = shared
-                    .entry((occ.representation, material))
-                    .or_insert_with(|| Arc::new(Geometry::Surfaces(surfaces)));
-                Geometry::Instance(Instance::new(part.clone(), placement))
-            } else {
-                let mut g = Geometry::Surfaces(surfaces);
-                g.transform(&placement);
-                g
-            };
-            ((k, material), geometry)
-        })
-        .collect()
+    Ok((model, report))
 }
 
 /// The entities of face `fid`; a face that is valid STEP but uses what the reader does not
@@ -416,21 +386,4 @@ fn resolve_face(
             None => Err(e),
         },
     }
-}
-
-/// The surfaces of a STEP file as one geometry (for a scene's `File("part.step")`).
-pub fn load_geometry(path: &Path) -> Result<Geometry, LoadError> {
-    let model = read_step(path)?;
-    if let Some(w) = model.report.warning(path) {
-        eprintln!("{w}");
-    }
-    let surfaces = model
-        .objects
-        .into_iter()
-        .flat_map(|o| match o.geometry.resolved().into_owned() {
-            Geometry::Surfaces(s) => s,
-            _ => Vec::new(),
-        })
-        .collect();
-    Ok(Geometry::Surfaces(surfaces))
 }

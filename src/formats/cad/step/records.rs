@@ -81,6 +81,8 @@ pub struct Exchange<'a> {
     pub header: Vec<Record<'a>>,
     pub instances: Vec<Instance<'a>>,
     index: HashMap<u64, usize>,
+    /// What the syntax tolerated, one line each (backslashes kept as text).
+    pub warnings: Vec<String>,
 }
 
 impl<'a> Exchange<'a> {
@@ -354,6 +356,12 @@ pub fn parse(src: &str) -> Result<Exchange<'_>, LexError> {
             }
             TokenKind::Keyword("END-ISO-10303-21") => {
                 p.expect(TokenKind::Semicolon, "`;` after `END-ISO-10303-21`")?;
+                if let Some((line, column, text)) = &p.lexer.first_literal {
+                    ex.warnings.push(format!(
+                        "{line}:{column}: {} backslash(es) in strings begin no escape of ISO 10303-21 §6.4.3 (first `{text}`, as in a Windows path) and were kept as text",
+                        p.lexer.literal_backslashes
+                    ));
+                }
                 return Ok(ex);
             }
             _ => return Err(Parser::unexpected(&t, "`DATA` or `END-ISO-10303-21`")),
