@@ -33,6 +33,7 @@ mod robust_mesh_files;
 mod robust_parsers;
 mod stability_suite;
 mod step_entities;
+mod step_faces;
 mod step_part;
 mod subdiv_surface;
 mod subdiv_tessellate;

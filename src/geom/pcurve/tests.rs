@@ -1,0 +1,71 @@
+use std::f64::consts::TAU;
+
+use super::*;
+use crate::geom::nurbs::shapes;
+
+/// A cylinder of radius `r` about z in closed form: `(r cos u, r sin u, v)`, u 2π-periodic.
+struct Cylinder {
+    r: f64,
+}
+
+impl ParamSurface for Cylinder {
+    fn point(&self, uv: DVec2) -> DVec3 {
+        DVec3::new(self.r * uv.x.cos(), self.r * uv.x.sin(), uv.y)
+    }
+
+    fn parameters(&self, p: DVec3) -> Option<DVec2> {
+        Some(DVec2::new(p.y.atan2(p.x), p.z))
+    }
+
+    fn periods(&self) -> [Option<f64>; 2] {
+        [Some(TAU), None]
+    }
+}
+
+#[test]
+fn a_helix_crossing_the_seam_stays_continuous() {
+    // The helix (r cos t, r sin t, c t) is u = t, v = c t on the cylinder: it crosses the
+    // seam (u = ±π) three times, and must come out as one increasing line, not jumps.
+    let (r, c) = (2.0, 0.3);
+    let s = Cylinder { r };
+    let helix = |t: f64| DVec3::new(r * t.cos(), r * t.sin(), c * t);
+    let p = project(&s, helix, 0.5, 0.5 + 3.0 * TAU, 1e-9).unwrap();
+    assert!(p.error < 1e-12, "{}", p.error);
+    assert!((p.points[0] - DVec2::new(0.5, 0.5 * c)).length() < 1e-12);
+    for w in p.points.windows(2) {
+        assert!(
+            w[1].x > w[0].x,
+            "u runs on across the seam: {} {}",
+            w[0],
+            w[1]
+        );
+        // Every vertex on the line v = c u (closed form).
+        assert!((w[1].y - c * w[1].x).abs() < 1e-12, "{}", w[1]);
+    }
+    let end = *p.points.last().unwrap();
+    assert!((end.x - (0.5 + 3.0 * TAU)).abs() < 1e-12, "{end}");
+}
+
+#[test]
+fn a_circle_of_latitude_on_a_nurbs_sphere_lands_on_it() {
+    // A circle at height h on the unit-radius sphere: its projection's chords, mapped back
+    // onto the NURBS, must stay within the tolerance of that circle (closed form: z = h,
+    // distance √(r² − h²) from the axis).
+    let (r, h) = (1.5, 0.6);
+    let sphere = shapes::sphere(r).unwrap();
+    let target = NurbsTarget::new(&sphere);
+    let rho = (r * r - h * h).sqrt();
+    let circle = |t: f64| DVec3::new(rho * t.cos(), rho * t.sin(), h);
+    let tol = 1e-6;
+    let p = project(&target, circle, 0.2, 0.2 + 1.5, tol).unwrap();
+    assert!(p.error <= tol, "{}", p.error);
+    assert!(p.points.len() > 5, "refined: {} points", p.points.len());
+    for w in p.points.windows(2) {
+        for k in 0..=4 {
+            let uv = w[0].lerp(w[1], k as f64 / 4.0);
+            let q = sphere.eval(uv.x, uv.y);
+            let off = (q.z - h).hypot(q.truncate().length() - rho);
+            assert!(off <= 2.0 * tol, "{q} is {off} off the circle");
+        }
+    }
+}

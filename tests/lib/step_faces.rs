@@ -1,0 +1,347 @@
+//! STEP faces CAD systems write that are not a plain outer loop of edges with pcurves:
+//! faces without bounds (whole spheres, B-spline surfaces), a sphere cap bounded by one
+//! circle, a cylinder bounded by two circles and no seam, B-splines whose knots are
+//! implied (ISO 10303-42 §4.3.4), and an edge whose LINE lies beside its vertices. Each
+//! is checked against the closed form or an independent Cox–de Boor evaluation.
+
+use crate::step_support;
+
+use std::f64::consts::{FRAC_PI_2, TAU};
+use std::path::Path;
+
+use glam::{DVec2, DVec3};
+use patchtrace::formats::cad::step::{StepModel, read_step_str};
+use patchtrace::scene::model::{Geometry, Surface, SurfaceGeometry};
+use step_support::{StepWriter, basis};
+
+fn read(text: &str) -> StepModel {
+    read_step_str(Path::new("test.step"), text).unwrap_or_else(|e| panic!("{e}\n{text}"))
+}
+
+/// The model's only surface; no face may have failed.
+fn only_surface(m: &StepModel) -> Surface {
+    assert!(
+        m.report.failed_faces.is_empty(),
+        "{:?}",
+        m.report.failed_faces
+    );
+    let mut all: Vec<Surface> = m
+        .objects
+        .iter()
+        .flat_map(|o| match &o.geometry {
+            Geometry::Surfaces(s) => s.clone(),
+            _ => Vec::new(),
+        })
+        .collect();
+    assert_eq!(all.len(), 1);
+    all.remove(0)
+}
+
+/// The NURBS domain in the definition's parameters (through `trim_space`).
+fn mapped_domain(s: &Surface) -> (DVec2, DVec2) {
+    let SurfaceGeometry::Nurbs(n) = &s.geometry else {
+        panic!("expected a NURBS surface")
+    };
+    let d = n.domain();
+    (
+        DVec2::new(s.trim_space[0].apply(d.u0), s.trim_space[1].apply(d.v0)),
+        DVec2::new(s.trim_space[0].apply(d.u1), s.trim_space[1].apply(d.v1)),
+    )
+}
+
+fn assert_close(a: DVec2, b: DVec2, tol: f64, what: &str) {
+    assert!((a - b).abs().max_element() <= tol, "{what}: {a} vs {b}");
+}
+
+/// Points of the NURBS over a 9 × 9 grid of its domain.
+fn grid_points(s: &Surface) -> Vec<DVec3> {
+    let SurfaceGeometry::Nurbs(n) = &s.geometry else {
+        panic!("expected a NURBS surface")
+    };
+    let d = n.domain();
+    (0..=8)
+        .flat_map(|i| (0..=8).map(move |j| (i as f64 / 8.0, j as f64 / 8.0)))
+        .map(|(a, b)| n.eval(d.u0 + (d.u1 - d.u0) * a, d.v0 + (d.v1 - d.v0) * b))
+        .collect()
+}
+
+/// SPHERICAL_SURFACE at `centre` with radius `r` and axis −z (as a BGA's balls are
+/// written).
+fn sphere(w: &mut StepWriter, centre: DVec3, r: f64) -> u64 {
+    let ax = w.axis(centre, -DVec3::Z, -DVec3::X);
+    w.add(format!(
+        "SPHERICAL_SURFACE('',#{ax},{})",
+        step_support::real(r)
+    ))
+}
+
+#[test]
+fn a_face_without_bounds_is_the_whole_sphere() {
+    let (centre, r) = (DVec3::new(-4.225, 4.225, 0.178), 0.1778);
+    let mut w = StepWriter::default();
+    let s = sphere(&mut w, centre, r);
+    w.face(&[], s);
+    let s = only_surface(&read(&w.finish()));
+    assert!(s.trims.is_empty(), "no trims: the whole surface");
+    let (lo, hi) = mapped_domain(&s);
+    assert_close(lo, DVec2::new(0.0, -FRAC_PI_2), 1e-12, "domain low");
+    assert_close(hi, DVec2::new(TAU, FRAC_PI_2), 1e-12, "domain high");
+    for p in grid_points(&s) {
+        let off = (p.distance(centre) - r).abs();
+        assert!(off <= 1e-12 * r, "{p} is {off} off the sphere");
+    }
+}
+
+/// A sphere face bounded by one circle of latitude v = 0.4: by ISO 10303-42 the face lies
+/// to the left of its bound seen from outside, so the circle run counter-clockwise about
+/// the sphere's axis bounds the cap over it, and the same bound with orientation FALSE
+/// the rest of the sphere below it.
+#[test]
+fn one_circle_bounds_a_sphere_cap_on_its_left() {
+    let (centre, r, v) = (DVec3::new(1.0, 2.0, 3.0), 2.0, 0.4);
+    for (orientation, v_lo, v_hi) in [(true, v, FRAC_PI_2), (false, -FRAC_PI_2, v)] {
+        let mut w = StepWriter::default();
+        let ax = w.axis(centre, DVec3::Z, DVec3::X);
+        let s = w.add(format!(
+            "SPHERICAL_SURFACE('',#{ax},{})",
+            step_support::real(r)
+        ));
+        let h = centre + DVec3::Z * r * v.sin();
+        let cax = w.axis(h, DVec3::Z, DVec3::X);
+        let c = w.circle(cax, r * v.cos());
+        let vx = w.vertex(h + DVec3::X * r * v.cos());
+        let e = w.edge(vx, vx, c, true);
+        let oe = w.oriented(e, true);
+        let l = w.add(format!("EDGE_LOOP('',(#{oe}))"));
+        let sense = if orientation { ".T." } else { ".F." };
+        let b = w.add(format!("FACE_OUTER_BOUND('',#{l},{sense})"));
+        w.face(&[b], s);
+        let m = read(&w.finish());
+        let s = only_surface(&m);
+        let (lo, hi) = mapped_domain(&s);
+        assert_close(
+            DVec2::new(lo.y, hi.y),
+            DVec2::new(v_lo, v_hi),
+            1e-9,
+            &format!("latitudes of the cap, orientation {orientation}"),
+        );
+        assert!(m.report.max_projection_error <= 1e-12 * r);
+    }
+}
+
+/// A cylinder between two closed circle edges, both FACE_BOUND and neither outer, the
+/// second used backwards, off the origin (how NX writes a drilled hole; the geometry of
+/// face #494 of occt_bug27453_165-174_piattello.stp).
+#[test]
+fn a_cylinder_between_two_circles_without_a_seam() {
+    let (axis_at, r) = (DVec3::new(38.0069894887767, 38.0069894887771, 80.0), 3.2501);
+    let mut w = StepWriter::default();
+    let ax = w.axis(axis_at, DVec3::Z, DVec3::X);
+    let cyl = w.add(format!(
+        "CYLINDRICAL_SURFACE('',#{ax},{})",
+        step_support::real(r)
+    ));
+    let mut bounds = Vec::new();
+    for (z, orientation) in [(86.0, true), (68.0, false)] {
+        let c0 = DVec3::new(axis_at.x, axis_at.y, z);
+        let cax = w.axis(c0, DVec3::Z, DVec3::X);
+        let c = w.circle(cax, r);
+        let vx = w.vertex(c0 + DVec3::X * r);
+        let e = w.edge(vx, vx, c, true);
+        bounds.push(w.bound(&[(e, orientation)], false));
+    }
+    w.face_with_sense(&bounds, cyl, false);
+    // A point far from the B-rep (the file this face comes from holds one half a
+    // kilometre away), which must not widen the face's tolerances.
+    w.point(DVec3::new(-494999.984246378, 0.0, 0.0));
+    let s = only_surface(&read(&w.finish()));
+    // The face's normal is against the surface's, which the scene writes by exchanging
+    // the parameters: (v, u).
+    let (lo, hi) = mapped_domain(&s);
+    let (lo, hi) = (DVec2::new(lo.y, lo.x), DVec2::new(hi.y, hi.x));
+    assert!((hi.x - lo.x - TAU).abs() <= 1e-9, "a whole turn: {lo} {hi}");
+    assert_close(
+        DVec2::new(lo.y, hi.y),
+        DVec2::new(-12.0, 6.0),
+        1e-9,
+        "heights",
+    );
+    assert_eq!(s.trims.len(), 2);
+    for p in grid_points(&s) {
+        let radial = (p - axis_at).truncate().length();
+        assert!((radial - r).abs() <= 1e-12 * r, "{p} is off the cylinder");
+    }
+}
+
+/// Cox–de Boor over knots written out here from ISO 10303-42 §4.3.4.
+fn cox_de_boor(
+    net: &[Vec<DVec3>],
+    p: (usize, usize),
+    k: (&[f64], &[f64]),
+    u: f64,
+    v: f64,
+) -> DVec3 {
+    let mut s = DVec3::ZERO;
+    for (i, row) in net.iter().enumerate() {
+        for (j, q) in row.iter().enumerate() {
+            s += *q * basis(i, p.0, k.0, u) * basis(j, p.1, k.1, v);
+        }
+    }
+    s
+}
+
+#[test]
+fn uniform_and_quasi_uniform_surfaces_take_their_implied_knots() {
+    let net: Vec<Vec<DVec3>> = (0..5)
+        .map(|i| {
+            (0..4)
+                .map(|j| {
+                    let (x, y) = (i as f64, j as f64);
+                    DVec3::new(x, y, 0.3 * (x * 1.3).sin() * (y * 0.7).cos())
+                })
+                .collect()
+        })
+        .collect();
+    // Degrees (2, 3) over 5 × 4 points: quasi-uniform knots are clamped with unit steps,
+    // uniform ones run from −degree by 1 (domain [0, count − degree]).
+    let cases = [
+        (
+            "QUASI_UNIFORM_SURFACE",
+            vec![0., 0., 0., 1., 2., 3., 3., 3.],
+            vec![0., 0., 0., 0., 1., 1., 1., 1.],
+            (0.0, 3.0, 0.0, 1.0),
+        ),
+        (
+            "UNIFORM_SURFACE",
+            vec![-2., -1., 0., 1., 2., 3., 4., 5.],
+            vec![-3., -2., -1., 0., 1., 2., 3., 4.],
+            (0.0, 3.0, 0.0, 1.0),
+        ),
+    ];
+    for (entity, ku, kv, (u0, u1, v0, v1)) in cases {
+        let mut w = StepWriter::default();
+        let rows: Vec<String> = net
+            .iter()
+            .map(|row| {
+                let ids: Vec<String> = row.iter().map(|&p| format!("#{}", w.point(p))).collect();
+                format!("({})", ids.join(","))
+            })
+            .collect();
+        let s = w.add(format!(
+            "{entity}('',2,3,({}),.UNSPECIFIED.,.F.,.F.,.F.)",
+            rows.join(",")
+        ));
+        w.face(&[], s);
+        let surface = only_surface(&read(&w.finish()));
+        let SurfaceGeometry::Nurbs(n) = &surface.geometry else {
+            panic!("expected a NURBS surface")
+        };
+        let d = n.domain();
+        assert_eq!(
+            (d.u0, d.u1, d.v0, d.v1),
+            (u0, u1, v0, v1),
+            "{entity} domain"
+        );
+        for i in 0..=6 {
+            for j in 0..=6 {
+                let u = u0 + (u1 - u0) * i as f64 / 6.0;
+                let v = v0 + (v1 - v0) * j as f64 / 6.0;
+                let want = cox_de_boor(&net, (2, 3), (&ku, &kv), u, v);
+                let got = n.eval(u, v);
+                assert!(
+                    got.distance(want) <= 1e-12 * 5.0,
+                    "{entity} at ({u}, {v}): {got} vs {want}"
+                );
+            }
+        }
+    }
+}
+
+/// A square face on the plane z = 0 whose left edge's LINE is written 0.3 beside its
+/// vertices, parallel to them (as some ECAD writers do): the line is taken through the
+/// vertices, as OpenCASCADE does, so nothing is projected with an error and the loop is
+/// the square.
+#[test]
+fn a_line_beside_its_vertices_is_moved_onto_them() {
+    let mut w = StepWriter::default();
+    let ax = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
+    let plane = w.add(format!("PLANE('',#{ax})"));
+    let corners = [
+        DVec3::new(0.0, 0.0, 0.0),
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(1.0, 1.0, 0.0),
+        DVec3::new(0.0, 1.0, 0.0),
+    ];
+    let vs: Vec<u64> = corners.iter().map(|&c| w.vertex(c)).collect();
+    let mut edges = Vec::new();
+    for k in 0..4 {
+        let (a, b) = (corners[k], corners[(k + 1) % 4]);
+        // The last edge's line lies 0.3 off the plane and 0.2 aside, parallel to its edge.
+        let shift = if k == 3 {
+            DVec3::new(-0.2, 0.0, 0.3)
+        } else {
+            DVec3::ZERO
+        };
+        let l = w.line(a + shift + 5.0 * (b - a), b - a);
+        edges.push((w.edge(vs[k], vs[(k + 1) % 4], l, true), true));
+    }
+    let b = w.bound(&edges, true);
+    w.face(&[b], plane);
+    let m = read(&w.finish());
+    let s = only_surface(&m);
+    assert!(
+        m.report.max_projection_error <= 1e-12,
+        "{}",
+        m.report.max_projection_error
+    );
+    let (lo, hi) = mapped_domain(&s);
+    assert_close(lo, DVec2::ZERO, 1e-12, "domain low");
+    assert_close(hi, DVec2::ONE, 1e-12, "domain high");
+}
+
+/// OFFSET_SURFACE of a sphere (a whole face) and of a cone (a band between two circles
+/// on the offset): every point of the face is `d` from the basis, by the closed forms
+/// (the sphere's radius; a cone's distance in its axial half-plane, |ρ − r − z tan α| cos α).
+#[test]
+fn offsets_of_a_sphere_and_a_cone_are_exact() {
+    let r = step_support::real;
+    let (centre, radius, d) = (DVec3::new(0.5, -1.0, 2.0), 1.2, 0.3);
+    let mut w = StepWriter::default();
+    let s = sphere(&mut w, centre, radius);
+    let off = w.add(format!("OFFSET_SURFACE('',#{s},{},.F.)", r(d)));
+    w.face(&[], off);
+    let surface = only_surface(&read(&w.finish()));
+    for p in grid_points(&surface) {
+        let err = (p.distance(centre) - (radius + d)).abs();
+        assert!(err <= 1e-12, "{p}: {err}");
+    }
+
+    let (rc, alpha, d) = (1.0, 0.4_f64, 0.25);
+    let mut w = StepWriter::default();
+    let ax = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
+    let cone = w.add(format!("CONICAL_SURFACE('',#{ax},{},{})", r(rc), r(alpha)));
+    let off = w.add(format!("OFFSET_SURFACE('',#{cone},{},.F.)", r(d)));
+    // The offset's circles at heights z: radius r + z tan α + d / cos α.
+    let mut bounds = Vec::new();
+    for (z, orientation) in [(0.2, false), (1.1, true)] {
+        let rho = rc + z * alpha.tan() + d / alpha.cos();
+        let cax = w.axis(DVec3::new(0.0, 0.0, z), DVec3::Z, DVec3::X);
+        let c = w.circle(cax, rho);
+        let vx = w.vertex(DVec3::new(rho, 0.0, z));
+        let e = w.edge(vx, vx, c, true);
+        bounds.push(w.bound(&[(e, orientation)], false));
+    }
+    w.face(&bounds, off);
+    let m = read(&w.finish());
+    let surface = only_surface(&m);
+    assert!(m.report.max_projection_error <= 1e-12);
+    for p in grid_points(&surface) {
+        let rho = p.truncate().length();
+        let err = ((rho - rc - p.z * alpha.tan()) * alpha.cos() - d).abs();
+        assert!(err <= 1e-12, "{p}: {err}");
+        assert!(
+            p.z >= 0.2 - 1e-12 && p.z <= 1.1 + 1e-12,
+            "{p} beyond the band"
+        );
+    }
+}
