@@ -152,7 +152,7 @@ fn a_cylinder_between_two_circles_without_a_seam() {
     }
     w.face_with_sense(&bounds, cyl, false);
     // A point far from the B-rep (the file this face comes from holds one half a
-    // kilometre away), which must not widen the face's tolerances.
+    // kilometre away), which must not widen the tolerances.
     w.point(DVec3::new(-494999.984246378, 0.0, 0.0));
     let s = only_surface(&read(&w.finish()));
     // The face's normal is against the surface's, which the scene writes by exchanging
@@ -344,4 +344,145 @@ fn offsets_of_a_sphere_and_a_cone_are_exact() {
             "{p} beyond the band"
         );
     }
+}
+
+/// B_SPLINE_CURVE_WITH_KNOTS of degree 2 through `points` (clamped, unit knot steps).
+fn quadratic_curve(w: &mut StepWriter, points: &[DVec3]) -> (u64, Vec<f64>) {
+    let n = points.len();
+    let ids: Vec<String> = points.iter().map(|&p| format!("#{}", w.point(p))).collect();
+    let inner = n - 3;
+    let mut mults = vec!["3".to_string()];
+    mults.extend((0..inner).map(|_| "1".to_string()));
+    mults.push("3".into());
+    let knots: Vec<String> = (0..=inner + 1).map(|k| format!("{k}.")).collect();
+    let id = w.add(format!(
+        "B_SPLINE_CURVE_WITH_KNOTS('',2,({}),.UNSPECIFIED.,.T.,.F.,({}),({}),.UNSPECIFIED.)",
+        ids.join(","),
+        mults.join(","),
+        knots.join(",")
+    ));
+    let mut full = vec![0.0; 3];
+    full.extend((1..=inner).map(|k| k as f64));
+    full.extend([(inner + 1) as f64; 3]);
+    (id, full)
+}
+
+/// A SURFACE_OF_LINEAR_EXTRUSION of a closed B-spline profile (CATIA's "tabulated
+/// cylinder"), bounded by the profile and its copy one extrusion up: the profile's
+/// parameter wraps like an angle, so each bound goes once around and the face is the
+/// band between them; its points are the profile's (Cox–de Boor) plus v times the
+/// extrusion.
+#[test]
+fn a_band_around_an_extruded_closed_profile() {
+    let ring = [
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(1.0, 1.0, 0.0),
+        DVec3::new(-1.0, 1.0, 0.0),
+        DVec3::new(-1.0, -1.0, 0.0),
+        DVec3::new(1.0, -1.0, 0.0),
+        DVec3::new(1.0, 0.0, 0.0),
+    ];
+    let up = DVec3::new(0.0, 0.2, 1.5);
+    let mut w = StepWriter::default();
+    let (profile, knots) = quadratic_curve(&mut w, &ring);
+    let dir = w.dir(up.normalize());
+    let vec = w.add(format!(
+        "VECTOR('',#{dir},{})",
+        step_support::real(up.length())
+    ));
+    let ext = w.add(format!("SURFACE_OF_LINEAR_EXTRUSION('',#{profile},#{vec})"));
+    let top: Vec<DVec3> = ring.iter().map(|&p| p + up).collect();
+    let (top_curve, _) = quadratic_curve(&mut w, &top);
+    let mut bounds = Vec::new();
+    for (curve, start, orientation) in [(profile, ring[0], true), (top_curve, top[0], false)] {
+        let v = w.vertex(start);
+        let e = w.edge(v, v, curve, true);
+        bounds.push(w.bound(&[(e, orientation)], orientation));
+    }
+    w.face(&bounds, ext);
+    let m = read(&w.finish());
+    let s = only_surface(&m);
+    assert!(
+        m.report.max_projection_error <= 1e-9,
+        "{}",
+        m.report.max_projection_error
+    );
+    assert_eq!(s.trims.len(), 2);
+    let (lo, hi) = mapped_domain(&s);
+    assert_close(lo, DVec2::new(0.0, 0.0), 1e-9, "domain low");
+    assert_close(hi, DVec2::new(4.0, 1.0), 1e-9, "domain high");
+    let SurfaceGeometry::Nurbs(n) = &s.geometry else {
+        panic!("expected a NURBS surface")
+    };
+    let d = n.domain();
+    for i in 0..=16 {
+        for j in 0..=4 {
+            let su = d.u0 + (d.u1 - d.u0) * i as f64 / 16.0;
+            let sv = d.v0 + (d.v1 - d.v0) * j as f64 / 4.0;
+            let (u, v) = (s.trim_space[0].apply(su), s.trim_space[1].apply(sv));
+            let c: DVec3 = (0..ring.len())
+                .map(|k| ring[k] * basis(k, 2, &knots, u))
+                .sum();
+            let want = c + v * up;
+            let got = n.eval(su, sv);
+            assert!(got.distance(want) <= 1e-12, "({u}, {v}): {got} vs {want}");
+        }
+    }
+}
+
+/// A ball drilled along x: a sphere face whose only bounds are the two circles where the
+/// hole leaves it, both FACE_BOUND and used clockwise seen from outside (the face on
+/// their right: holes, ISO 10303-42 face_bound). The face is the sphere without the two
+/// caps |x| > c: checked at the points of the NURBS against that closed form.
+#[test]
+fn a_sphere_with_holes_only_is_the_sphere_without_them() {
+    let (r, c) = (1.0, 0.6_f64);
+    let rho = (r * r - c * c).sqrt();
+    let mut w = StepWriter::default();
+    let ax = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
+    let s = w.add(format!(
+        "SPHERICAL_SURFACE('',#{ax},{})",
+        step_support::real(r)
+    ));
+    let mut bounds = Vec::new();
+    for side in [1.0, -1.0] {
+        // Counter-clockwise about the outward axis ±x, used backwards: clockwise seen
+        // from outside.
+        let cax = w.axis(DVec3::X * c * side, DVec3::X * side, DVec3::Y);
+        let circle = w.circle(cax, rho);
+        let vx = w.vertex(DVec3::X * c * side + DVec3::Y * rho);
+        let e = w.edge(vx, vx, circle, true);
+        bounds.push(w.bound(&[(e, false)], false));
+    }
+    w.face(&bounds, s);
+    let surface = only_surface(&read(&w.finish()));
+    let region = surface.trim_region().unwrap().expect("trimmed");
+    let SurfaceGeometry::Nurbs(n) = &surface.geometry else {
+        panic!("expected a NURBS surface")
+    };
+    let d = n.domain();
+    let mut checked = 0;
+    let mut wrong = Vec::new();
+    for i in 0..=40 {
+        for j in 1..40 {
+            let su = d.u0 + (d.u1 - d.u0) * i as f64 / 40.0;
+            let sv = d.v0 + (d.v1 - d.v0) * j as f64 / 40.0;
+            let p = n.eval(su, sv);
+            if (p.x.abs() - c).abs() < 0.05 {
+                continue;
+            }
+            checked += 1;
+            if region.contains(su, sv) != (p.x.abs() < c) {
+                wrong.push((su, sv, p));
+            }
+        }
+    }
+    assert!(checked > 1000, "{checked}");
+    assert!(
+        wrong.is_empty(),
+        "{} of {checked} wrong, e.g. {:?}; domain {d:?}, trims {:?}",
+        wrong.len(),
+        &wrong[..wrong.len().min(8)],
+        mapped_domain(&surface)
+    );
 }

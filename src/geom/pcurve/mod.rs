@@ -51,10 +51,15 @@ pub fn parameters_near(s: &impl ParamSurface, p: DVec3, near: Option<DVec2>) -> 
     })
 }
 
-/// Whether a periodic u collapses at `uv` (a sphere's pole, a cone's apex): a whole
-/// radian of u moves the point by at most `tol`.
-pub fn collapsed_u(s: &impl ParamSurface, uv: DVec2, tol: f64) -> bool {
-    s.periods()[0].is_some() && s.point(uv).distance(s.point(uv + DVec2::X)) <= tol
+/// Whether the periodic parameter `axis` (0 for u, 1 for v) collapses at `uv` (a sphere's
+/// pole, a cone's apex, the degenerate edge of a closed B-spline): a quarter period along
+/// it moves the point by at most `tol`.
+pub fn collapsed(s: &impl ParamSurface, uv: DVec2, axis: usize, tol: f64) -> bool {
+    s.periods()[axis].is_some_and(|p| {
+        let mut step = DVec2::ZERO;
+        step[axis] = 0.25 * p;
+        s.point(uv).distance(s.point(uv + step)) <= tol
+    })
 }
 
 /// A curve projected into a surface's parameters.
@@ -84,14 +89,11 @@ pub fn project(
         worst = worst.max(s.point(uv).distance(p));
         Ok(uv)
     };
-    // Start samples, split until no step between neighbours moves a periodic parameter by
-    // more than a quarter period: unwrapping to the nearest period is only sure for steps
-    // below half of one (a helix sampled four times over three turns would otherwise run
-    // backwards).
+    // Start samples, split until unwrapping each through the midpoint of its step agrees
+    // with unwrapping it directly: unwrapping to the nearest period is only right for
+    // steps below half a period (a helix sampled four times over three turns would
+    // otherwise run backwards).
     let periods = s.periods();
-    let jumps = |a: DVec2, b: DVec2| {
-        (0..2).any(|k| periods[k].is_some_and(|p| (b[k] - a[k]).abs() > 0.25 * p))
-    };
     let mut ts = vec![ta];
     let mut uvs = vec![measure(ta, None)?];
     let mut pending: Vec<(f64, usize)> = (1..=MIN_SEGMENTS)
@@ -101,13 +103,30 @@ pub fn project(
     while let Some((t, depth)) = pending.pop() {
         let (t0, a) = (ts[ts.len() - 1], uvs[uvs.len() - 1]);
         let uv = measure(t, Some(a))?;
-        if jumps(a, uv) && depth < MAX_REFINE {
+        let mid = measure(0.5 * (t0 + t), Some(a))?;
+        let jumps = (0..2).any(|k| {
+            periods[k].is_some_and(|p| (unwrap(uv[k], mid[k], Some(p)) - uv[k]).abs() > 0.5 * p)
+        });
+        if jumps && depth < MAX_REFINE {
             pending.push((t, depth + 1));
             pending.push((0.5 * (t0 + t), depth + 1));
             continue;
         }
         ts.push(t);
         uvs.push(uv);
+    }
+    // Samples at a pole take the periodic parameter of their neighbour along the curve
+    // (any value is the same point there; the neighbour's keeps the chords on the curve).
+    for axis in 0..2 {
+        for k in 0..uvs.len() {
+            if collapsed(s, uvs[k], axis, tol) {
+                let next = (k + 1..uvs.len()).find(|&j| !collapsed(s, uvs[j], axis, tol));
+                let prev = (0..k).rev().find(|&j| !collapsed(s, uvs[j], axis, tol));
+                if let Some(j) = next.or(prev) {
+                    uvs[k][axis] = uvs[j][axis];
+                }
+            }
+        }
     }
     // Refine: a stack of segments, left to right.
     let mut out = vec![uvs[0]];
@@ -118,7 +137,12 @@ pub fn project(
     let mut chord_worst: f64 = 0.0;
     while let Some((t0, a, t1, b, depth)) = stack.pop() {
         let tm = 0.5 * (t0 + t1);
-        let m = measure(tm, Some(a))?;
+        let mut m = measure(tm, Some(a))?;
+        for axis in 0..2 {
+            if collapsed(s, m, axis, tol) {
+                m[axis] = 0.5 * (a[axis] + b[axis]);
+            }
+        }
         // The chord's error against the projected curve (the curve's own distance from
         // the surface is the projection error, measured in `measure`).
         let err = s.point(0.5 * (a + b)).distance(s.point(m));
@@ -128,21 +152,6 @@ pub fn project(
         } else {
             chord_worst = chord_worst.max(err);
             out.push(b);
-        }
-    }
-    // Points at a pole take the angle of their neighbour along the curve.
-    for k in 0..out.len() {
-        if collapsed_u(s, out[k], tol) {
-            let neighbour = if k + 1 < out.len() && !collapsed_u(s, out[k + 1], tol) {
-                Some(out[k + 1].x)
-            } else if k > 0 {
-                Some(out[k - 1].x)
-            } else {
-                None
-            };
-            if let Some(u) = neighbour {
-                out[k].x = u;
-            }
         }
     }
     Ok(Projected {

@@ -69,3 +69,40 @@ fn a_circle_of_latitude_on_a_nurbs_sphere_lands_on_it() {
         }
     }
 }
+
+/// The unit sphere in closed form: `(cos v cos u, cos v sin u, sin v)`, u 2π-periodic,
+/// the poles at v = ±π/2.
+struct Sphere;
+
+impl ParamSurface for Sphere {
+    fn point(&self, uv: DVec2) -> DVec3 {
+        DVec3::new(uv.y.cos() * uv.x.cos(), uv.y.cos() * uv.x.sin(), uv.y.sin())
+    }
+
+    fn parameters(&self, p: DVec3) -> Option<DVec2> {
+        Some(DVec2::new(p.y.atan2(p.x), p.z.atan2(p.x.hypot(p.y))))
+    }
+
+    fn periods(&self) -> [Option<f64>; 2] {
+        [Some(TAU), None]
+    }
+}
+
+#[test]
+fn a_meridian_from_the_pole_keeps_its_longitude() {
+    // The meridian u = 1 from the north pole to the equator: at the pole any u is the
+    // same point, and the projection must take the meridian's (closed form: u = 1,
+    // v = π/2 − t), not whatever atan2(0, 0) gives, or its first chord would cut across.
+    let u = 1.0_f64;
+    let meridian = |t: f64| Sphere.point(DVec2::new(u, std::f64::consts::FRAC_PI_2 - t));
+    let p = project(&Sphere, meridian, 0.0, 1.5, 1e-9).unwrap();
+    assert!(p.error < 1e-12, "{}", p.error);
+    for q in &p.points {
+        assert!((q.x - u).abs() < 1e-12, "{q}");
+    }
+    assert!(
+        p.points.len() < 100,
+        "no refinement at the pole: {}",
+        p.points.len()
+    );
+}

@@ -127,19 +127,15 @@ struct Domain<'f> {
 
 impl ParamSurface for Domain<'_> {
     fn point(&self, uv: DVec2) -> DVec3 {
-        match self.def {
-            // A closed B-spline taken as periodic: parameters beyond its domain wrap.
-            SurfaceDef::BSpline(n) => {
-                let d = n.domain();
-                let wrap =
-                    |x: f64, lo: f64, p: Option<f64>| p.map_or(x, |p| lo + (x - lo).rem_euclid(p));
-                n.eval(
-                    wrap(uv.x, d.u0, self.periods[0]),
-                    wrap(uv.y, d.v0, self.periods[1]),
-                )
+        // A closed B-spline (surface or profile) taken as periodic: parameters beyond its
+        // domain wrap into it.
+        let mut w = uv;
+        for axis in 0..2 {
+            if let (Some(p), Some((lo, _))) = (self.periods[axis], self.def.fixed_span(axis)) {
+                w[axis] = lo + (w[axis] - lo).rem_euclid(p);
             }
-            def => def.point(uv.x, uv.y),
         }
+        self.def.point(w.x, w.y)
     }
 
     fn parameters(&self, p: DVec3) -> Option<DVec2> {
@@ -166,7 +162,7 @@ impl Domain<'_> {
     /// Whether the periodic u collapses at `uv` (a sphere's pole, a cone's apex), where the
     /// angle of a point means nothing.
     fn collapsed_u(&self, uv: DVec2) -> bool {
-        pcurve::collapsed_u(self, uv, self.scale * CHORD_TOLERANCE)
+        pcurve::collapsed(self, uv, 0, self.scale * CHORD_TOLERANCE)
     }
 
     /// The projection of `c` over `[ta, tb]` into the parameter plane (`geom::pcurve`),
@@ -291,6 +287,41 @@ fn closed_periods(n: &NurbsSurface, tol: f64) -> [Option<f64>; 2] {
     ]
 }
 
+/// Twice the signed area a loop encloses in the parameter plane as traversed (positive
+/// counter-clockwise), from its pieces' samples.
+fn signed_area(pieces: &[Piece]) -> f64 {
+    let mut points: Vec<DVec2> = Vec::new();
+    for p in pieces {
+        let start = points.len();
+        points.extend(p.samples());
+        if p.reversed {
+            points[start..].reverse();
+        }
+    }
+    (0..points.len())
+        .map(|k| points[k].perp_dot(points[(k + 1) % points.len()]))
+        .sum()
+}
+
+/// The whole range of v of a surface closed in it (from pole to pole of a sphere, over a
+/// revolution's profile, a turn of a torus's tube from `v0`, a B-spline's domain).
+fn natural_v(def: &SurfaceDef, v0: f64) -> Option<(f64, f64)> {
+    use std::f64::consts::{FRAC_PI_2, TAU};
+    match def {
+        SurfaceDef::Sphere { .. } => Some((-FRAC_PI_2, FRAC_PI_2)),
+        SurfaceDef::Torus { .. } => Some((v0, v0 + TAU)),
+        SurfaceDef::Revolution { profile, .. } => {
+            let (a, b) = profile.domain();
+            (a.is_finite() && b.is_finite()).then_some((a, b))
+        }
+        SurfaceDef::BSpline(n) => {
+            let d = n.domain();
+            Some((d.v0, d.v1))
+        }
+        _ => None,
+    }
+}
+
 /// Where a sphere's or cone's v meets its axis beyond `v`, upwards (`high`) or
 /// downwards: a pole (v = ±π/2) or the apex (v = −r / tan α); `None` on that side of
 /// every other surface, which goes on without end there.
@@ -345,39 +376,24 @@ fn whole_face(face: &Face) -> Result<FaceOutcome, String> {
     })
 }
 
-/// The diagonal of the box of the face's bounds: every edge's ends and middle, and the
-/// points of vertex loops; 0 for a face without bounds.
-fn bounds_extent(face: &Face) -> f64 {
+/// The diagonal of the box of the faces' vertices (edge ends and vertex loops): the
+/// model's size as its B-rep spans it; `None` for faces without vertices.
+pub fn faces_extent<'f>(faces: impl Iterator<Item = &'f Face>) -> Option<f64> {
     let mut lo = DVec3::splat(f64::INFINITY);
     let mut hi = DVec3::splat(f64::NEG_INFINITY);
-    for b in &face.bounds {
-        let mids = b.edges.iter().map(|oe| {
-            let (ta, tb) = edge_interval(&oe.edge);
-            oe.edge.curve.space_curve().point(0.5 * (ta + tb))
-        });
+    for b in faces.flat_map(|f| &f.bounds) {
         let ends = b.edges.iter().flat_map(|oe| [oe.edge.start, oe.edge.end]);
-        for p in ends.chain(mids).chain(b.vertex) {
-            if p.is_finite() {
-                lo = lo.min(p);
-                hi = hi.max(p);
-            }
+        for p in ends.chain(b.vertex).filter(|p| p.is_finite()) {
+            lo = lo.min(p);
+            hi = hi.max(p);
         }
     }
-    if lo.x <= hi.x { lo.distance(hi) } else { 0.0 }
+    (lo.x <= hi.x).then(|| lo.distance(hi).max(f64::MIN_POSITIVE))
 }
 
 /// Converts one face; the error says why it could not be (the caller names the face).
-/// `scale` is the model's size; the face's tolerances scale with the smaller of it and
-/// the extent of the face's own bounds, as a file may hold points far from its B-rep
-/// (one stray point half a kilometre away would otherwise make every tolerance
-/// metres wide).
+/// `scale` is the model's size, which the tolerances are relative to.
 pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
-    let extent = bounds_extent(face);
-    let scale = if extent > 0.0 {
-        scale.min(extent)
-    } else {
-        scale
-    };
     let def = &*face.surface;
     let inverter = match def {
         SurfaceDef::BSpline(n) => Some(Inverter::new(n)),
@@ -400,9 +416,10 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
     if face.bounds.iter().all(|b| b.edges.is_empty()) {
         return whole_face(face);
     }
-    // Each loop's pieces, the periodic axis it winds around (if it does), and whether it
-    // runs towards increasing parameter along that axis as a bound of the face.
-    let mut loops: Vec<(Vec<Piece>, Option<usize>, bool)> = Vec::new();
+    // Each loop's pieces, the periodic axis it winds around (if it does), whether it
+    // runs towards increasing parameter along that axis as a bound of the face, and
+    // whether the face lies to the left of its pieces as traversed.
+    let mut loops: Vec<(Vec<Piece>, Option<usize>, bool, bool)> = Vec::new();
     let mut extent_points: Vec<DVec2> = Vec::new();
     let mut outer_u: Option<(f64, f64)> = None;
     let outer_index = face.bounds.iter().position(|b| b.outer).unwrap_or(0);
@@ -496,11 +513,9 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
             }
             pieces.push(piece);
         }
-        // A closed B-spline's outer loop is placed by whole periods over its domain (the
-        // seam's points invert to either end).
-        if let (None, SurfaceDef::BSpline(n)) = (outer_u, def) {
-            let d = n.domain();
-            let centre = DVec2::new(0.5 * (d.u0 + d.u1), 0.5 * (d.v0 + d.v1));
+        // On a closed B-spline (surface or profile) the outer loop is placed by whole
+        // periods over its domain (the seam's points invert to either end).
+        if outer_u.is_none() {
             let mut lo = DVec2::splat(f64::INFINITY);
             let mut hi = DVec2::splat(f64::NEG_INFINITY);
             for q in pieces.iter().flat_map(Piece::samples) {
@@ -509,8 +524,9 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
             }
             let mut shift = DVec2::ZERO;
             for axis in 0..2 {
-                if let Some(p) = dom.periods[axis] {
-                    shift[axis] = ((centre[axis] - 0.5 * (lo[axis] + hi[axis])) / p).round() * p;
+                if let (Some(p), Some((a, b))) = (dom.periods[axis], def.fixed_span(axis)) {
+                    let centre = 0.5 * (a + b);
+                    shift[axis] = ((centre - 0.5 * (lo[axis] + hi[axis])) / p).round() * p;
                 }
             }
             if shift != DVec2::ZERO {
@@ -553,9 +569,9 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
         // ISO 10303-42 §5.4.x: a FALSE face_bound orientation reverses every oriented
         // edge of its loop, and a face whose same_sense is FALSE has its normal against
         // the surface's, so its loops' left side is the surface's right.
-        let forwards =
-            winds.is_some_and(|axis| gap[axis] < 0.0) == (bound.orientation == face.same_sense);
-        loops.push((pieces, winds, forwards));
+        let left = bound.orientation == face.same_sense;
+        let forwards = winds.is_some_and(|axis| gap[axis] < 0.0) == left;
+        loops.push((pieces, winds, forwards, left));
     }
     // The surface over the loops' extent (B-splines keep their own domain).
     let mut lo = DVec2::splat(f64::INFINITY);
@@ -581,21 +597,42 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
         lo.y = lo.y.max(-std::f64::consts::FRAC_PI_2);
         hi.y = hi.y.min(std::f64::consts::FRAC_PI_2);
     }
+    // Bounds that are all holes (each loop has the face on its right, ISO 10303-42
+    // face_bound, and none is the outer bound): the face is its closed surface with those
+    // holes cut out (a ball drilled through), so it spans the surface's natural range.
+    let all_holes = !face.bounds.iter().any(|b| b.outer && !b.edges.is_empty())
+        && loops
+            .iter()
+            .all(|l| l.1.is_none() && (signed_area(&l.0) > 0.0) != l.3);
+    // Only a surface closed around u (or a B-spline closed either way) can be such a
+    // face; elsewhere the loops are taken as they come, as before.
+    let natural = match (all_holes, dom.periods[0], def) {
+        (false, ..) => None,
+        (true, Some(p), _) => natural_v(def, lo.y).map(|v| ([lo.x, lo.x + p], v)),
+        (true, None, SurfaceDef::BSpline(_)) if dom.periods[1].is_some() => {
+            natural_v(def, lo.y).map(|v| ([lo.x, hi.x], v))
+        }
+        _ => None,
+    };
+    if let Some(([u0, u1], (v0, v1))) = natural {
+        lo = DVec2::new(u0, v0);
+        hi = DVec2::new(u1, v1);
+    }
+    let all_holes = natural.is_some();
     // Loops winding around u an odd number of times leave one side of the face open:
-    // on a sphere or cone it closes at a pole or apex, on the face's side of the first
-    // such loop (a face lies to the left of its bounds, ISO 10303-42 §5.4.x face_bound),
-    // and every winding loop is closed beyond the range on that side.
+    // it is the face's side of the first such loop (a face lies to the left of its
+    // bounds, ISO 10303-42 face_bound), where every winding loop is closed beyond the
+    // range so that even–odd parity keeps the face; without other bounds there (a
+    // vertex loop at the apex), a sphere's or cone's face reaches its pole or apex.
     let mut close_high = true;
     let mut around_u = loops.iter().filter(|l| l.1 == Some(0));
     if around_u.clone().count() % 2 == 1
         && let Some(first) = around_u.next()
     {
-        let v = first.0[0].start().y;
-        if lo.y < hi.y {
-            // Other bounds (a vertex loop at the apex) already give the open side.
-            close_high = (v - lo.y).abs() <= (hi.y - v).abs();
-        } else {
-            close_high = first.2;
+        close_high = first.2;
+        // No extent in v beyond the loop's own rounding: nothing else bounds that side.
+        if !(hi.y - lo.y > 1e-9 * (1.0 + lo.y.abs().max(hi.y.abs()))) {
+            let v = first.0[0].start().y;
             let pole = pole_towards(def, v, close_high).ok_or_else(|| {
                 "its single loop around the surface leaves the face unbounded on one side"
                     .to_string()
@@ -616,7 +653,7 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
         surface_to_nurbs(def, [lo.x, hi.x], [lo.y, hi.y]).map_err(|e| e.to_string())?;
     // Winding loops close beyond the other parameter's range, all on the same side.
     let mut trims = Vec::new();
-    for (k, (mut pieces, winds, _)) in loops.into_iter().enumerate() {
+    for (k, (mut pieces, winds, _, _)) in loops.into_iter().enumerate() {
         if let Some(axis) = winds {
             let other = 1 - axis;
             let margin = (hi[other] - lo[other]).max(1.0);
@@ -636,7 +673,8 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
             ));
         }
         trims.push(TrimLoop {
-            hole: k > 0,
+            // Holes only: the surface's domain is the outer bound (`geom::trim`).
+            hole: all_holes || k > 0,
             // A segment runs from t0 to t1 in either order (`geom::trim`): reversed
             // pieces swap them, so each segment starts where the previous one ended.
             segments: pieces
