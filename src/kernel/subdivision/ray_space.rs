@@ -41,7 +41,7 @@
 //! refraction rays from every hit with the default configuration, so in ray space, and
 //! counts 0 self-hits on every case.
 //!
-//! Precision. The transformed points are rounded to ulps of their distance from the ray
+//! Kernel. The transformed points are rounded to ulps of their distance from the ray
 //! origin, while the world net is exact only to ulps of its own coordinates: the end game
 //! ([`super::search`]) stops at the larger of the two ([`RayFrame::world_length`]), so the
 //! search never refines below the precision of the net it came from.
