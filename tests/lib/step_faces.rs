@@ -486,3 +486,57 @@ fn a_sphere_with_holes_only_is_the_sphere_without_them() {
         mapped_domain(&surface)
     );
 }
+
+/// A sphere cap bounded by a circle and a seam run down to the pole and back, whose
+/// bound says the cap is on the other side (the geometry of face #11034 of
+/// occt_ec_turbine-A.stp, which Euclid wrote): the loop's extent decides, as
+/// OpenCASCADE's healing does (it renders the cap the seam runs into). Checked: the face
+/// spans the latitudes from the pole to the circle and keeps points inside them.
+#[test]
+fn a_cap_closed_through_its_seam_is_the_side_the_seam_runs_into() {
+    let (r, c) = (11.5, -0.2094395_f64);
+    let mut w = StepWriter::default();
+    let ax = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
+    let s = w.add(format!(
+        "SPHERICAL_SURFACE('',#{ax},{})",
+        step_support::real(r)
+    ));
+    let cax = w.axis(DVec3::Z * r * c.sin(), DVec3::Z, DVec3::X);
+    let circle = w.circle(cax, r * c.cos());
+    let start = DVec3::new(r * c.cos(), 0.0, r * c.sin());
+    let v0 = w.vertex(start);
+    let ring = w.edge(v0, v0, circle, true);
+    // The meridian through the circle's vertex, from it down to the south pole.
+    let max = w.axis(DVec3::ZERO, DVec3::Y, DVec3::X);
+    let meridian = w.circle(max, r);
+    let pole = w.vertex(-DVec3::Z * r);
+    let seam = w.edge(v0, pole, meridian, true);
+    let oes: Vec<u64> = [(ring, false), (seam, true), (seam, false)]
+        .iter()
+        .map(|&(e, o)| w.oriented(e, o))
+        .collect();
+    let l = w.add(format!(
+        "EDGE_LOOP('',({}))",
+        oes.iter()
+            .map(|i| format!("#{i}"))
+            .collect::<Vec<_>>()
+            .join(",")
+    ));
+    let b = w.add(format!("FACE_BOUND('',#{l},.F.)"));
+    w.face(&[b], s);
+    let surface = only_surface(&read(&w.finish()));
+    let (lo, hi) = mapped_domain(&surface);
+    assert_close(
+        DVec2::new(lo.y, hi.y),
+        DVec2::new(-FRAC_PI_2, c),
+        1e-6,
+        "latitudes",
+    );
+    let region = surface.trim_region().unwrap().expect("trimmed");
+    let SurfaceGeometry::Nurbs(n) = &surface.geometry else {
+        panic!("expected a NURBS surface")
+    };
+    let d = n.domain();
+    let (su, sv) = (0.5 * (d.u0 + d.u1), 0.5 * (d.v0 + d.v1));
+    assert!(region.contains(su, sv), "the middle of the cap is kept");
+}

@@ -619,20 +619,21 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
         hi = DVec2::new(u1, v1);
     }
     let all_holes = natural.is_some();
-    // Loops winding around u an odd number of times leave one side of the face open:
-    // it is the face's side of the first such loop (a face lies to the left of its
-    // bounds, ISO 10303-42 face_bound), where every winding loop is closed beyond the
-    // range so that even–odd parity keeps the face; without other bounds there (a
-    // vertex loop at the apex), a sphere's or cone's face reaches its pole or apex.
+    // Loops winding around u an odd number of times leave one side of the face open,
+    // where every winding loop is closed beyond the range so that even–odd parity keeps
+    // the face. Alone, the first such loop gives that side by its orientation (a face
+    // lies to the left of its bounds, ISO 10303-42 face_bound) and the face reaches the
+    // pole or apex there; otherwise the other bounds' extent gives it.
     let mut close_high = true;
     let mut around_u = loops.iter().filter(|l| l.1 == Some(0));
     if around_u.clone().count() % 2 == 1
         && let Some(first) = around_u.next()
     {
-        close_high = first.2;
+        let v = first.0[0].start().y;
         // No extent in v beyond the loop's own rounding: nothing else bounds that side.
-        if !(hi.y - lo.y > 1e-9 * (1.0 + lo.y.abs().max(hi.y.abs()))) {
-            let v = first.0[0].start().y;
+        let slack = 1e-9 * (1.0 + lo.y.abs().max(hi.y.abs()));
+        if (hi.y - lo.y).partial_cmp(&slack) != Some(std::cmp::Ordering::Greater) {
+            close_high = first.2;
             let pole = pole_towards(def, v, close_high).ok_or_else(|| {
                 "its single loop around the surface leaves the face unbounded on one side"
                     .to_string()
@@ -642,6 +643,11 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
             } else {
                 lo.y = pole;
             }
+        } else {
+            // Other bounds (a vertex loop at the apex, a seam run to the pole) give the
+            // open side, whatever the loop's orientation says (OpenCASCADE's healing
+            // turns such a loop around too).
+            close_high = (v - lo.y).abs() <= (hi.y - v).abs();
         }
     }
     if !(lo.x < hi.x && lo.y < hi.y) {
