@@ -1,5 +1,5 @@
 //! The clap definitions of every subcommand. Man pages are generated from these (see
-//! `tests/man_pages.rs`), so the help text here is the documentation.
+//! `tests/cli/man_pages.rs`), so the help text here is the documentation.
 
 use std::path::PathBuf;
 

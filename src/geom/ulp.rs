@@ -8,7 +8,7 @@
 /// mean / 99th-percentile hit-point distance to the `f64` reference in those ulps):
 /// K = 0: 78.2, 4.3 / 33; 4: 72.4, 4.5 / 35; 8: 68.2, 4.9 / 37; 16: 64.3, 6.0 / 44.
 /// 8 saves an eighth of the splits for an error still well inside the de Casteljau
-/// rounding bound the tests allow (tests/kernel_newton.rs).
+/// rounding bound the tests allow (tests/lib/kernel_newton.rs).
 pub const DEFAULT_END_ULPS: u32 = 8;
 
 /// Moves `x` by `n` representable `f32` values towards `+inf` (n > 0) or `-inf` (n < 0).

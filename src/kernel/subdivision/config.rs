@@ -21,7 +21,7 @@ pub enum SplitHeuristic {
 /// division, so crack freedom does not depend on it and it only ends the end game early.
 /// 16 keeps the box within 16 ulps per coordinate (Dammertz Table 2.12: mean error about
 /// twice that of dist 0). Not yet tuned by measurement: the Newton test
-/// (tests/kernel_newton.rs) passes with it, the split savings are unmeasured.
+/// (tests/lib/kernel_newton.rs) passes with it, the split savings are unmeasured.
 pub const DEFAULT_RATIONAL_DIST: u32 = 16;
 
 /// End-game threshold of the float-precision criterion: where it is measured and why 8,
@@ -38,7 +38,7 @@ pub use crate::geom::ulp::DEFAULT_END_ULPS;
 /// primary rays take at most 3786 splits per test (`cargo bench --bench kernel`); with
 /// 2560 the few pairs above that coarsened and moved the mean hit error from 13.8 to 27
 /// ulps (max 1.15e6, along a grazing ray). Rational patches converge more slowly (their
-/// boxes come from homogeneous division, §2.7.2): a ray of tests/kernel_newton.rs at a
+/// boxes come from homogeneous division, §2.7.2): a ray of tests/lib/kernel_newton.rs at a
 /// random rational patch needs 7150 splits, and a budget of 4096 moved its hit 1e-3 off
 /// the crossing. 16384 leaves a factor of two above that; the stability suite's worst
 /// unbudgeted test (15251 splits, a folded patch) stays just below it.

@@ -77,7 +77,7 @@ pub const TRANSFORM_ULPS: f64 = 8.0;
 /// net lets it through on A's side. Culling A by its world box then loses the hit, or
 /// hands the ray to a surface behind (measured without the margin: 1 ray in 180,000 aimed
 /// at the shared edges and extraordinary vertices of three subdivision surfaces went
-/// through the cube's, `tests/subdiv_surface.rs`). A ray-space coordinate is within [`TRANSFORM_ULPS`]
+/// through the cube's, `tests/lib/subdiv_surface.rs`). A ray-space coordinate is within [`TRANSFORM_ULPS`]
 /// ulps of its exact value at the ray-space scale `|p - o| / |d|`, which is at most two
 /// ulps of `|p - o|` back in world units, on each of the two axes across the ray: within
 /// `2 √2 TRANSFORM_ULPS` ulps (about 22.6) of `|p - o|` of the ray. 32 also covers the
