@@ -10,9 +10,10 @@
 use std::path::Path;
 use std::time::Instant;
 
-use patchtrace::accel::scene::{Precision, QueryStats, SceneGeometry};
+use patchtrace::accel::scene::{QueryStats, SceneGeometry};
 use patchtrace::formats::{bpt::read_bpt, load_scene};
 use patchtrace::geom::Ray;
+use patchtrace::kernel::Kernel;
 use patchtrace::kernel::subdivision::SubdivisionConfig;
 use patchtrace::render::camera::CameraRays;
 use patchtrace::scene::{Geometry, Object, Scene, Surface};
@@ -28,7 +29,7 @@ const SIZE: u32 = 512;
 /// Median wall seconds and median on-CPU seconds (wall where unavailable) to trace `rays`
 /// through `geometry`, and the number of hits.
 fn time(geometry: &SceneGeometry, rays: &[Ray]) -> (f64, f64, usize) {
-    let precision = Precision::F32(SubdivisionConfig::default());
+    let precision = Kernel::F32(SubdivisionConfig::default());
     let (mut wall, mut cpu) = (Vec::new(), Vec::new());
     let mut hits = 0;
     for run in 0..=RUNS {

@@ -14,10 +14,11 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use patchtrace::accel::scene::{Precision, QueryStats, SceneGeometry};
+use patchtrace::accel::scene::{QueryStats, SceneGeometry};
 use patchtrace::formats::write::write_scene_as;
 use patchtrace::formats::{LoadOptions, load_scene_with};
 use patchtrace::geom::Ray;
+use patchtrace::kernel::Kernel;
 use patchtrace::kernel::secondary::DEFAULT_ULPS;
 use patchtrace::kernel::subdivision::SubdivisionConfig;
 use patchtrace::progress::ProgressBar;
@@ -82,7 +83,7 @@ impl Case {
 
     /// One render and one pass of the camera rays alone, each timed on the one thread
     /// of `pool`.
-    fn run(&mut self, pool: &rayon::ThreadPool, precision: Precision) {
+    fn run(&mut self, pool: &rayon::ThreadPool, precision: Kernel) {
         let integrator = Integrator {
             scene: &self.scene,
             geometry: &self.geometry,
@@ -139,7 +140,7 @@ fn main() {
         .num_threads(1)
         .build()
         .expect("a one-thread pool");
-    let precision = Precision::F32(SubdivisionConfig::default());
+    let precision = Kernel::F32(SubdivisionConfig::default());
     println!("load average before: {}", load_average());
     // A warm-up round, then RUNS interleaved rounds.
     for round in 0..=RUNS {

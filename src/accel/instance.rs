@@ -29,10 +29,11 @@
 
 use glam::{DAffine3, DMat3, DVec3, Vec3};
 
-use super::scene::{Precision, SceneGeometry, SceneHit};
+use super::scene::{SceneGeometry, SceneHit};
 use crate::geom::bbox::DAabb;
 use crate::geom::ulp::ulp_of;
 use crate::geom::{Aabb, Ray};
+use crate::kernel::Kernel;
 use crate::kernel::subdivision::{ScreenFootprint, Termination};
 
 /// How many times the world-space image of the re-entry rounding the leave box is grown
@@ -57,7 +58,7 @@ pub(super) struct Placement {
     pub bounds: Aabb,
     /// The accelerator number of the prototype's patch 0 in this instance: hits name
     /// `first_primitive + p` so secondary rays know their surface of origin
-    /// ([`Precision::leaving`]); `None` when the scene has more than `u32` numbers.
+    /// ([`Kernel::leaving`]); `None` when the scene has more than `u32` numbers.
     first_primitive: Option<u32>,
 }
 
@@ -119,27 +120,27 @@ impl Placement {
     /// `precision` for the object-space ray: the adaptive criterion's footprint mapped
     /// into object space, and a surface of origin in this instance named by its number
     /// in the prototype (none elsewhere).
-    pub fn precision_in_object(&self, precision: &Precision, patches: u32) -> Precision {
+    pub fn precision_in_object(&self, precision: &Kernel, patches: u32) -> Kernel {
         let local = |origin: Option<u32>| {
             let (o, first) = (origin?, self.first_primitive?);
             o.checked_sub(first).filter(|&p| p < patches)
         };
         match *precision {
-            Precision::F32(mut cfg) => {
+            Kernel::F32(mut cfg) => {
                 if let Termination::Adaptive(fp) = cfg.termination {
                     cfg.termination =
                         Termination::Adaptive(footprint_in_object(fp, &self.to_world.matrix3));
                 }
-                Precision::F32(cfg)
+                Kernel::F32(cfg)
             }
-            Precision::F64(cfg) => Precision::F64(cfg),
-            Precision::Toth(mut cfg) => {
+            Kernel::F64(cfg) => Kernel::F64(cfg),
+            Kernel::Toth(mut cfg) => {
                 cfg.surface_of_origin = local(cfg.surface_of_origin);
-                Precision::Toth(cfg)
+                Kernel::Toth(cfg)
             }
-            Precision::Cached(mut cfg) => {
+            Kernel::Cached(mut cfg) => {
                 cfg.toth.surface_of_origin = local(cfg.toth.surface_of_origin);
-                Precision::Cached(cfg)
+                Kernel::Cached(cfg)
             }
         }
     }
@@ -197,10 +198,7 @@ fn to_daabb(b: &Aabb) -> DAabb {
     if b.is_empty() {
         return DAabb::EMPTY;
     }
-    DAabb {
-        min: b.min.as_dvec3(),
-        max: b.max.as_dvec3(),
-    }
+    b.to_f64()
 }
 
 /// The maximum absolute row sum of `m`: the operator norm for the ∞-norm.

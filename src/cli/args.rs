@@ -1,5 +1,5 @@
 //! The clap definitions of every subcommand. Man pages are generated from these (see
-//! `tests/man_pages.rs`), so the help text here is the documentation.
+//! `tests/cli/man_pages.rs`), so the help text here is the documentation.
 
 use std::path::PathBuf;
 
@@ -156,8 +156,8 @@ pub struct TeapotsArgs {
 
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// Scene (.ron) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb, .igs, .iges, .step,
-    /// .stp). For IGES and STEP files also the units, what was not read (by type),
+    /// Scene (.ron) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb, .stl, .igs, .iges,
+    /// .step, .stp). For IGES and STEP files also the units, what was not read (by type),
     /// surfaces not converted, and the largest error of projected trim curves.
     pub scene: PathBuf,
     #[command(flatten)]
@@ -495,7 +495,8 @@ pub struct TessellateArgs {
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
-    /// Output mesh: .obj, .gltf (buffer embedded) or .glb.
+    /// Output mesh: .obj, .gltf (buffer embedded), .glb or .stl (binary, coordinates in
+    /// `f32`).
     #[arg(short, long)]
     pub output: PathBuf,
     /// Uniform grid per patch with this many triangles (an even number 2·u·v, e.g. 512,
@@ -569,9 +570,22 @@ pub struct CompareArgs {
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
-    /// Triangles per patch of each tessellation to compare (even counts 2·u·v).
-    #[arg(long, value_delimiter = ',', default_values_t = crate::bench::accuracy::DEFAULT_TRIANGLES)]
+    /// Triangles per patch of each tessellation to compare (even counts 2·u·v). Default
+    /// 512,4608,131072 when neither --tolerance nor --against is given.
+    #[arg(long, value_delimiter = ',')]
     pub triangles: Vec<u32>,
+    /// Chord-height tolerances of adaptive, crack-free tessellations to compare, as CAD
+    /// systems tessellate: a plain number is a fraction of the model's size (its bounding
+    /// box diagonal), a number ending in `mm` an absolute length in scene units
+    /// (millimetres for CAD files). Example: 0.01,0.001,0.05mm.
+    #[arg(long, value_delimiter = ',', value_parser = parse_tolerance)]
+    pub tolerance: Vec<Tolerance>,
+    /// Meshes to compare with the direct render (.stl, .obj, .gltf, .glb), such as the one
+    /// a CAD system exported for the same model, in the scene's coordinates. Each is
+    /// rendered with the scene's camera and lights and one material, against the direct
+    /// render with that same material.
+    #[arg(long, value_delimiter = ',', value_name = "MESH")]
+    pub against: Vec<PathBuf>,
     /// Directory for the images, heat maps and the table (created if missing).
     #[arg(long, default_value = "compare-out")]
     pub out_dir: PathBuf,
@@ -674,5 +688,27 @@ mod tests {
         for bad in ["depth:0", "depth:65", "depth:", "depth:x", "fixed", ""] {
             assert!(parse(bad).is_err(), "{bad} accepted");
         }
+    }
+}
+
+/// A chord-height tolerance for `compare --tolerance`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Tolerance {
+    /// A fraction of the model's bounding box diagonal.
+    Relative(f64),
+    /// A length in scene units.
+    Absolute(f64),
+}
+
+fn parse_tolerance(s: &str) -> Result<Tolerance, String> {
+    let (number, make): (&str, fn(f64) -> Tolerance) = match s.strip_suffix("mm") {
+        Some(n) => (n.trim_end(), Tolerance::Absolute),
+        None => (s, Tolerance::Relative),
+    };
+    match number.parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(make(x)),
+        _ => Err(format!(
+            "expected a positive number (a fraction of the model's size) or a length such as 0.05mm, found `{s}`"
+        )),
     }
 }

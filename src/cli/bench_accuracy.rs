@@ -16,7 +16,7 @@ use crate::render::camera::CameraRays;
 pub fn run(args: AccuracyArgs) -> anyhow::Result<ExitCode> {
     let mut scene = load(&args.scene, &args.mesh, args.quiet)?;
     if let Some(n) = args.size {
-        anyhow::ensure!(n > 0, "--size must be at least 1");
+        ensure_arg!(n > 0, "--size must be at least 1");
         scene.camera.width = n;
         scene.camera.height = n;
     }

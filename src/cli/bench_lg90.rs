@@ -10,9 +10,9 @@ use crate::io::write_atomic;
 use crate::kernel::cached::DEFAULT_CACHE_BYTES;
 
 pub fn run(args: Lg90Args) -> anyhow::Result<ExitCode> {
-    anyhow::ensure!(args.size > 0, "--size must be at least 1");
+    ensure_arg!(args.size > 0, "--size must be at least 1");
     for &c in &args.cases {
-        anyhow::ensure!(
+        ensure_arg!(
             CASES.iter().any(|case| case.number == c),
             "--cases: there is no test case {c}; Table 1 has cases 1 to 5"
         );
@@ -22,18 +22,18 @@ pub fn run(args: Lg90Args) -> anyhow::Result<ExitCode> {
         .iter()
         .map(|name| {
             Method::by_name(name).ok_or_else(|| {
-                anyhow::anyhow!(
+                crate::cli::BadArgument(format!(
                     "--methods: unknown method `{name}`; expected TOTH, ISRT, SCAN, ITBUF or PEANO"
-                )
+                ))
             })
         })
-        .collect::<anyhow::Result<Vec<_>>>()?;
+        .collect::<Result<Vec<_>, _>>()?;
     let pool = thread_pool(args.threads)?;
     let temp = match &args.scene_dir {
         Some(_) => None,
         None => Some(tempfile_dir()?),
     };
-    anyhow::ensure!(
+    ensure_arg!(
         args.cache_size != Some(0),
         "--cache-size must be at least 1 (MiB)"
     );

@@ -10,9 +10,14 @@ use crate::cli::setup::{build_bvh, load_keyed};
 pub fn run(args: BvhArgs) -> anyhow::Result<ExitCode> {
     let (scene, source) = load_keyed(&args.scene, &args.mesh, args.quiet, (false, None))?;
     // What "built in" covers: collecting the patches (NURBS to Bézier, trims), their boxes,
-    // the tree and its wide form, and preparing the patches for the kernel.
+    // the tree and its wide form, and preparing the patches for the kernel; built where
+    // `render` builds it, at the scene's floating origin.
     let start = Instant::now();
-    let geometry = build_bvh(&scene, args.quiet);
+    let origin = scene.floating_origin();
+    let mut moved = scene.clone();
+    moved.translate(-origin);
+    let geometry = build_bvh(&moved, args.quiet);
+    drop(moved);
     let build = start.elapsed().as_secs_f64();
     let key = crate::accel::mapped::key(source, false);
     let parsed = match crate::formats::load::InputKind::of(&args.scene) {
@@ -30,7 +35,7 @@ pub fn run(args: BvhArgs) -> anyhow::Result<ExitCode> {
     let with_patches = geometry.save_bvh(
         &args.output,
         key,
-        scene.trim_loop_count(),
+        (scene.trim_loop_count(), origin),
         parsed,
         &piece_of,
     )?;

@@ -1,6 +1,8 @@
-//! `patchtrace compare SCENE --triangles 512,4608,131072`: the direct render against
-//! triangle tessellations of the same scene (Dammertz Fig. 2.1/2.2, Tables 2.1–2.4), as one
-//! table of cost and error, with the images and heat maps written to `--out-dir`.
+//! `patchtrace compare SCENE --triangles 512,4608,131072 --tolerance 0.001,0.05mm --against
+//! MESH`: the direct render against triangle tessellations of the same scene (Dammertz
+//! Fig. 2.1/2.2, Tables 2.1–2.4) by triangles per patch or by chord height, and against
+//! meshes made elsewhere (a CAD system's STL export), as one table of cost and error, with
+//! the images and heat maps written to `--out-dir`.
 
 use std::fmt::Write as _;
 use std::io::Write;
@@ -10,21 +12,23 @@ use std::time::Instant;
 
 use anyhow::Context;
 
-use crate::accel::scene::Precision;
 use crate::bench::accuracy::patch_memory;
-use crate::cli::args::CompareArgs;
+use crate::cli::args::{CompareArgs, Tolerance};
 use crate::cli::setup::{build_bvh, load, tessellate, thread_pool};
-use crate::diff::heatmap::heat_map;
 use crate::diff::{DiffOptions, Image, diff_images};
+use crate::formats::LoadError;
+use crate::formats::load::load_geometry;
 use crate::io::write_atomic;
+use crate::kernel::Kernel;
 use crate::kernel::secondary::DEFAULT_ULPS;
 use crate::kernel::subdivision::SubdivisionConfig;
 use crate::render::film::Film;
+use crate::render::heatmap::heat_map;
 use crate::render::integrator::{Integrator, TraceSettings};
 use crate::render::plan::EffectPlan;
 use crate::render::renderer::render_image;
-use crate::scene::Scene;
-use crate::tessellate::TessellationMode;
+use crate::scene::{Geometry, Object, Scene, TriangleMesh};
+use crate::tessellate::{TessellationMode, TessellationReport};
 
 /// One line of the table.
 struct Row {
@@ -50,7 +54,7 @@ fn render(scene: &Scene, quiet: bool, label: &str, pool: &rayon::ThreadPool) -> 
         scene,
         geometry: &geometry,
         settings: TraceSettings {
-            precision: Precision::F32(SubdivisionConfig::default()),
+            precision: Kernel::F32(SubdivisionConfig::default()),
             ulps: DEFAULT_ULPS,
             plan: EffectPlan::for_scene(scene),
         },
@@ -65,6 +69,10 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     let pool = thread_pool(args.threads)?;
     let mut scene = load(&args.scene, &args.mesh, args.quiet)?;
     args.size.apply(&args.scene, &mut scene)?;
+    // Direct and tessellated renders both at the scene's floating origin: the images, the
+    // only outputs, are the same in either frame. Meshes given with --against move too.
+    let origin = scene.floating_origin();
+    scene.translate(-origin);
     crate::scene::check_film_pixels(scene.camera.width, scene.camera.height)
         .map_err(crate::cli::BadArgument)?;
     std::fs::create_dir_all(&args.out_dir)
@@ -89,33 +97,84 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
         trim_gap: None,
     }];
 
-    for &n in &args.triangles {
+    let triangles =
+        if args.triangles.is_empty() && args.tolerance.is_empty() && args.against.is_empty() {
+            crate::bench::accuracy::DEFAULT_TRIANGLES.to_vec()
+        } else {
+            args.triangles.clone()
+        };
+    let size = scene.bounds().diagonal();
+    let modes = triangles
+        .iter()
+        .map(|&n| {
+            (
+                format!("{n} triangles/patch"),
+                (format!("tess{n}"), format!("flip{n}")),
+                TessellationMode::TrianglesPerPatch(n),
+            )
+        })
+        .chain(args.tolerance.iter().map(|t| {
+            let (label, tolerance) = match *t {
+                Tolerance::Relative(f) => (format!("chord {f} of the size"), f * size),
+                Tolerance::Absolute(d) => (format!("chord {d} mm"), d),
+            };
+            let name = format!("chord{tolerance:.3e}");
+            let names = (name.clone(), format!("flip-{name}"));
+            (label, names, TessellationMode::Adaptive { tolerance })
+        }));
+    for (label, names, mode) in modes {
         let start = Instant::now();
-        let label = format!("{n} triangles/patch");
-        let (meshes, report) = tessellate(
-            &scene,
-            TessellationMode::TrianglesPerPatch(n),
-            args.quiet,
-            &format!("tessellating, {label}"),
-        )?;
+        let (meshes, report) =
+            tessellate(&scene, mode, args.quiet, &format!("tessellating, {label}"))?;
         let tessellate_seconds = start.elapsed().as_secs_f64();
-        let (film, build, render_seconds) = render(&meshes, args.quiet, &label, &pool);
-        film.write(&args.out_dir.join(format!("tess{n}.png")))?;
-        let d = diff_images(&reference, &Image::from_film(&film), DiffOptions::default())?;
-        heat_map(&d.maps.flip, d.width, d.height)
-            .write_png(&args.out_dir.join(format!("flip{n}.png")))?;
-        rows.push(Row {
-            method: format!("{n} triangles/patch"),
-            triangles: report.triangles,
-            memory_bytes: report.bytes,
-            build_seconds: tessellate_seconds + build,
-            render_seconds,
-            rmse: d.rmse,
-            psnr: d.psnr,
-            flip_mean: d.flip.mean,
-            silhouette_pixels: d.coverage_mismatch.unwrap_or(0),
-            trim_gap: (report.trim_gaps.faces > 0).then_some(report.trim_gaps.largest),
-        });
+        let against = Against {
+            reference: &reference,
+            out_dir: &args.out_dir,
+            quiet: args.quiet,
+            pool: &pool,
+        };
+        let mut row = against.row(&meshes, &label, &names)?;
+        row.triangles = report.triangles;
+        row.memory_bytes = report.bytes;
+        row.build_seconds += tessellate_seconds;
+        row.trim_gap = (report.trim_gaps.faces > 0).then_some(report.trim_gaps.largest);
+        rows.push(row);
+    }
+
+    if !args.against.is_empty() {
+        // External meshes carry no materials: both sides are rendered with one.
+        let plain = one_material(&scene);
+        let (direct, _, _) = render(&plain, args.quiet, "direct, one material", &pool);
+        direct.write(&args.out_dir.join("direct-plain.png"))?;
+        let reference = Image::from_film(&direct);
+        let against = Against {
+            reference: &reference,
+            out_dir: &args.out_dir,
+            quiet: args.quiet,
+            pool: &pool,
+        };
+        for (k, path) in args.against.iter().enumerate() {
+            let mesh = match load_geometry(path)? {
+                Geometry::Mesh(m) => m,
+                _ => {
+                    return Err(LoadError::invalid(
+                        path,
+                        "--against takes a triangle mesh (.stl, .obj of faces, .gltf, .glb)",
+                    )
+                    .into());
+                }
+            };
+            let (meshes, report) = with_mesh(&plain, mesh, origin);
+            let label = path.file_name().map_or_else(
+                || path.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            );
+            let names = (format!("against{k}"), format!("flip-against{k}"));
+            let mut row = against.row(&meshes, &label, &names)?;
+            row.triangles = report.triangles;
+            row.memory_bytes = report.bytes;
+            rows.push(row);
+        }
     }
 
     let markdown = markdown_table(&rows);
@@ -132,6 +191,76 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
         );
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// What every compared render is measured against, and where its files go.
+struct Against<'a> {
+    reference: &'a Image,
+    out_dir: &'a Path,
+    quiet: bool,
+    pool: &'a rayon::ThreadPool,
+}
+
+impl Against<'_> {
+    /// Renders `meshes`, writes the image and its FLIP heat map as `<image>.png` and
+    /// `<heat>.png`, and returns its row (triangle counts and memory for the caller to
+    /// fill in).
+    fn row(
+        &self,
+        meshes: &Scene,
+        label: &str,
+        (image, heat): &(String, String),
+    ) -> anyhow::Result<Row> {
+        let (film, build, render_seconds) = render(meshes, self.quiet, label, self.pool);
+        film.write(&self.out_dir.join(format!("{image}.png")))?;
+        let d = diff_images(
+            self.reference,
+            &Image::from_film(&film),
+            DiffOptions::default(),
+        )?;
+        heat_map(&d.maps.flip, d.width, d.height)
+            .write_png(&self.out_dir.join(format!("{heat}.png")))?;
+        Ok(Row {
+            method: label.to_string(),
+            triangles: 0,
+            memory_bytes: 0,
+            build_seconds: build,
+            render_seconds,
+            rmse: d.rmse,
+            psnr: d.psnr,
+            flip_mean: d.flip.mean,
+            silhouette_pixels: d.coverage_mismatch.unwrap_or(0),
+            trim_gap: None,
+        })
+    }
+}
+
+/// `scene` with every object given its first material, so that it compares with a mesh
+/// that has none.
+fn one_material(scene: &Scene) -> Scene {
+    let mut plain = scene.clone();
+    for o in &mut plain.objects {
+        o.material = 0;
+    }
+    plain
+}
+
+/// `scene`'s camera, lights and materials with `mesh` (in world space, moved by minus the
+/// scene's floating `origin`) as its one object, and the mesh's counts.
+fn with_mesh(
+    scene: &Scene,
+    mut mesh: TriangleMesh,
+    origin: glam::DVec3,
+) -> (Scene, TessellationReport) {
+    mesh.transform(&glam::DAffine3::from_translation(-origin));
+    let report = TessellationReport::of(&mesh);
+    let mut s = scene.clone();
+    s.objects = vec![Object {
+        name: "mesh".into(),
+        material: 0,
+        geometry: Geometry::Mesh(mesh),
+    }];
+    (s, report)
 }
 
 fn write_text(path: &Path, text: &str) -> anyhow::Result<()> {

@@ -7,9 +7,9 @@ use serde::Serialize;
 
 use crate::cli::EXIT_FAILURE;
 use crate::cli::args::{DiffArgs, HeatmapChoice};
-use crate::diff::heatmap::heat_map;
 use crate::diff::{DiffError, DiffOptions, DiffReport, Exceeded, Space, diff_images, read_image};
 use crate::formats::LoadError;
+use crate::render::heatmap::heat_map;
 
 /// The JSON document: the report plus the inputs and the limits exceeded.
 #[derive(Serialize)]

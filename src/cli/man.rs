@@ -1,5 +1,5 @@
 //! Man pages generated from the clap definitions (clap_mangen), so the pages and the
-//! parser never disagree. `tests/man_pages.rs` fails when `man/` is stale.
+//! parser never disagree. `tests/cli/man_pages.rs` fails when `man/` is stale.
 
 use clap::CommandFactory;
 

@@ -29,7 +29,7 @@ pub fn run(args: MergeArgs) -> anyhow::Result<ExitCode> {
     let first = &pieces[0].info;
     for (piece, path) in pieces.iter().zip(&args.pieces).skip(1) {
         let i = &piece.info;
-        anyhow::ensure!(
+        ensure_arg!(
             (i.width, i.height, &i.provenance) == (first.width, first.height, &first.provenance),
             "{} does not come from the same render as {}:\n  {}\n  {}",
             path.display(),
@@ -39,16 +39,20 @@ pub fn run(args: MergeArgs) -> anyhow::Result<ExitCode> {
         );
     }
     let windows: Vec<Window> = pieces.iter().map(|p| p.info.window).collect();
-    check_cover(&windows, first.width, first.height)
-        .map_err(|e| anyhow::anyhow!("the pieces do not cover the image once: {e}"))?;
+    check_cover(&windows, first.width, first.height).map_err(|e| {
+        crate::cli::BadArgument(format!("the pieces do not cover the image once: {e}"))
+    })?;
     let info = PieceInfo {
         window: Window::full(first.width, first.height),
         ..first.clone()
     };
     match (&pieces[0].pixels, format) {
-        (PiecePixels::Png(_), ImageFormat::Exr) => anyhow::bail!(
-            "PNG pieces hold 8-bit pixels, which cannot make the EXR a render writes; merge EXR pieces, or write a .png"
-        ),
+        (PiecePixels::Png(_), ImageFormat::Exr) => {
+            return Err(crate::cli::BadArgument(
+                "PNG pieces hold 8-bit pixels, which cannot make the EXR a render writes; merge EXR pieces, or write a .png".into(),
+            )
+            .into());
+        }
         (PiecePixels::Png(_), ImageFormat::Png) => {
             write_png(&args.output, &info, &join_png(&pieces, &args.pieces)?)?
         }
@@ -58,7 +62,9 @@ pub fn run(args: MergeArgs) -> anyhow::Result<ExitCode> {
                 ImageFormat::Exr => write_exr(&args.output, &info, channels)?,
                 ImageFormat::Png => {
                     let film = Film::from_rgba_channels(info.width, info.height, &channels)
-                        .ok_or_else(|| anyhow::anyhow!("the pieces have no R, G, B, A channels"))?;
+                        .ok_or_else(|| {
+                            crate::cli::BadArgument("the pieces have no R, G, B, A channels".into())
+                        })?;
                     write_png(&args.output, &info, &film.to_srgb8())?
                 }
             }
@@ -68,10 +74,11 @@ pub fn run(args: MergeArgs) -> anyhow::Result<ExitCode> {
 }
 
 fn mixed(path: &Path) -> anyhow::Error {
-    anyhow::anyhow!(
+    crate::cli::BadArgument(format!(
         "{}: the pieces mix EXR and PNG files or hold different channels",
         path.display()
-    )
+    ))
+    .into()
 }
 
 /// Copies each piece's rows into the whole image, `bytes` per pixel.

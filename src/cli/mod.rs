@@ -1,7 +1,17 @@
 //! The command-line interface: one file per subcommand. Flags are parsed by clap, turned
 //! into a validated configuration, and handed to the library. Errors are printed once,
 //! with their chain, and mapped to exit codes: 2 for bad input (parse errors, unreadable
-//! or invalid files), 1 for other failures.
+//! or invalid files, flags the command cannot honour), 1 for other failures.
+
+/// `anyhow::ensure!` for a flag, a flag combination or an input the command cannot honour:
+/// returns a [`BadArgument`] (exit status 2) with the message when `cond` is false.
+macro_rules! ensure_arg {
+    ($cond:expr, $($fmt:tt)+) => {
+        if !$cond {
+            return Err($crate::cli::BadArgument(format!($($fmt)+)).into());
+        }
+    };
+}
 
 pub mod args;
 mod bench;

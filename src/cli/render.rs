@@ -138,7 +138,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         if let Some(path) = &prepared.scene.animation {
             let camera = path.camera_at(&still, frame);
             let forward = camera.look_at - camera.eye;
-            anyhow::ensure!(
+            ensure_arg!(
                 forward.cross(camera.up).length_squared() > 0.0
                     && camera.fov_y > 0.0
                     && camera.fov_y < 180.0,
@@ -179,10 +179,10 @@ fn render_frame(
     let window = match (args.crop, args.tile) {
         (Some(crop), _) => {
             crop.check(width, height)
-                .map_err(|e| anyhow::anyhow!("--crop {crop}: {e}"))?;
+                .map_err(|e| crate::cli::BadArgument(format!("--crop {crop}: {e}")))?;
             crop
         }
-        (None, Some(tile)) => Window::tile(tile, width, height).map_err(anyhow::Error::msg)?,
+        (None, Some(tile)) => Window::tile(tile, width, height).map_err(crate::cli::BadArgument)?,
         (None, None) => Window::full(width, height),
     };
     crate::scene::check_film_pixels(window.width(), window.height())
@@ -217,7 +217,7 @@ fn render_frame(
         );
     }
     let start = Instant::now();
-    let layers = aov::channels(&aovs, &rendered);
+    let layers = aov::channels(&aovs, &rendered, prepared.origin);
     let mut written = Vec::new();
     match ImageFormat::of(output) {
         Some(ImageFormat::Exr) => {

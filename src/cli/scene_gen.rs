@@ -15,7 +15,7 @@ pub fn teapots(args: TeapotsArgs) -> anyhow::Result<ExitCode> {
         )
         .into());
     }
-    anyhow::ensure!(
+    ensure_arg!(
         args.width > 0 && args.height > 0,
         "--width and --height must be at least 1"
     );

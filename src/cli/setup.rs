@@ -5,13 +5,15 @@ use std::path::Path;
 use std::time::Instant;
 
 use anyhow::Context;
+use glam::DVec3;
 
-use crate::accel::scene::{FromFile, Precision, SceneGeometry};
+use crate::accel::scene::{FromFile, SceneGeometry};
 use crate::cli::args::{
     AccelChoice, HeuristicChoice, KernelArgs, KernelChoice, MeshArgs, PrecisionChoice,
     TerminationChoice,
 };
 use crate::formats::{load_scene_keyed, load_scene_with};
+use crate::kernel::Kernel;
 use crate::kernel::cached::{CachedConfig, DEFAULT_CACHE_BYTES, DEFAULT_MAX_DEPTH};
 use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig, Termination};
 use crate::kernel::toth::TothConfig;
@@ -24,20 +26,20 @@ use crate::tessellate::{
 
 /// The kernel path selected by the flags, or why the flags do not go together; `camera`
 /// sizes the pixels of adaptive termination.
-pub fn precision(args: &KernelArgs, camera: &Camera) -> anyhow::Result<Precision> {
+pub fn precision(args: &KernelArgs, camera: &Camera) -> anyhow::Result<Kernel> {
     if args.kernel != KernelChoice::Cached {
         for (flag, given) in [
             ("--cache-size", args.cache_size.is_some()),
             ("--cache-depth", args.cache_depth.is_some()),
         ] {
-            anyhow::ensure!(
+            ensure_arg!(
                 !given,
                 "{flag} sizes the surface-tree cache, which only --kernel cached has; add --kernel cached or drop {flag}"
             );
         }
     }
     if matches!(args.kernel, KernelChoice::Toth | KernelChoice::Cached) {
-        anyhow::ensure!(
+        ensure_arg!(
             args.precision == PrecisionChoice::F32,
             "--kernel toth and --kernel cached work on f32 rays and have no --precision f64 variant; use --kernel subdivision --precision f64 for the reference"
         );
@@ -46,16 +48,16 @@ pub fn precision(args: &KernelArgs, camera: &Camera) -> anyhow::Result<Precision
             ..TothConfig::default()
         };
         return Ok(match args.kernel {
-            KernelChoice::Cached => Precision::Cached(CachedConfig::new(
+            KernelChoice::Cached => Kernel::Cached(CachedConfig::new(
                 toth,
                 args.cache_size
                     .map_or(DEFAULT_CACHE_BYTES, |mib| mib.saturating_mul(1 << 20)),
                 args.cache_depth.unwrap_or(DEFAULT_MAX_DEPTH),
             )),
-            _ => Precision::Toth(toth),
+            _ => Kernel::Toth(toth),
         });
     }
-    anyhow::ensure!(
+    ensure_arg!(
         !args.isrt,
         "--isrt applies to the Toth kernels only; add --kernel toth or --kernel cached"
     );
@@ -77,8 +79,8 @@ pub fn precision(args: &KernelArgs, camera: &Camera) -> anyhow::Result<Precision
         cfg.rational_dist = d;
     }
     Ok(match args.precision {
-        PrecisionChoice::F32 => Precision::F32(cfg),
-        PrecisionChoice::F64 => Precision::F64(cfg),
+        PrecisionChoice::F32 => Kernel::F32(cfg),
+        PrecisionChoice::F64 => Kernel::F64(cfg),
     })
 }
 
@@ -92,6 +94,9 @@ pub struct Prepared {
     pub trims: TrimEffect,
     /// The key of the scene's inputs ([`load_scene_keyed`]): what its geometry is made from.
     pub source_key: u64,
+    /// The floating origin ([`crate::scene::origin`]): `scene` and `geometry` are the scene
+    /// as read moved by minus it, and a world position is a position in them plus it.
+    pub origin: DVec3,
 }
 
 /// Reads the scene at `path` with `--subdivide`'s options, under a spinner when the file is
@@ -118,7 +123,7 @@ pub fn prepare(
     args: &KernelArgs,
     quiet: bool,
 ) -> anyhow::Result<Prepared> {
-    anyhow::ensure!(
+    ensure_arg!(
         args.accel == AccelChoice::Bvh || args.bvh.is_none(),
         "--bvh loads a BVH file, which --accel grid does not use; drop one of the two flags"
     );
@@ -131,6 +136,8 @@ pub fn prepare(
     if args.ignore_trims {
         scene = scene.without_trims();
     }
+    let origin = scene.floating_origin();
+    scene.translate(-origin);
     let load_seconds = start.elapsed().as_secs_f64();
     let start = Instant::now();
     let geometry = match args.accel {
@@ -149,6 +156,7 @@ pub fn prepare(
         prepare_seconds: start.elapsed().as_secs_f64(),
         trims,
         source_key,
+        origin,
     })
 }
 
@@ -190,6 +198,7 @@ fn prepare_from_file(
     let start = Instant::now();
     let key = crate::accel::mapped::key(source, args.ignore_trims);
     let file = opened.check(bvh_path, key, scene.objects.len())?;
+    let origin = file.origin;
     let (scene, geometry, trims) = match SceneGeometry::from_file(file) {
         FromFile::Mapped(geometry, loops) => {
             let trims = TrimEffect {
@@ -197,6 +206,7 @@ fn prepare_from_file(
                 ignored: args.ignore_trims,
             };
             let mut scene = scene;
+            scene.translate(-origin);
             let pieces = geometry.mapped_pieces(scene.objects.len());
             for (object, pieces) in scene.objects.iter_mut().zip(pieces) {
                 if !pieces.is_empty() {
@@ -217,6 +227,7 @@ fn prepare_from_file(
             if args.ignore_trims {
                 scene = scene.without_trims();
             }
+            scene.translate(-origin);
             let geometry = SceneGeometry::with_tree(&scene, bvh, bvh_path)?;
             (scene, geometry, trims)
         }
@@ -228,6 +239,7 @@ fn prepare_from_file(
         prepare_seconds: start.elapsed().as_secs_f64(),
         trims,
         source_key: source,
+        origin,
     })
 }
 

@@ -1,4 +1,4 @@
-//! `patchtrace tessellate SCENE -o OUT.obj|OUT.gltf|OUT.glb`: the triangle baseline.
+//! `patchtrace tessellate SCENE -o OUT.obj|OUT.gltf|OUT.glb|OUT.stl`: the triangle baseline.
 
 use std::io::Write;
 use std::process::ExitCode;
@@ -41,7 +41,7 @@ pub fn run(args: TessellateArgs) -> anyhow::Result<ExitCode> {
     if MeshFormat::of(&args.output).is_none() {
         return Err(LoadError::invalid(
             &args.output,
-            "unsupported mesh type: expected .obj, .gltf or .glb",
+            "unsupported mesh type: expected .obj, .gltf, .glb or .stl",
         )
         .into());
     }

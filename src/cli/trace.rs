@@ -7,13 +7,14 @@ use std::process::ExitCode;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::accel::scene::{Precision, QueryStats, SceneGeometry, SceneHit};
+use crate::accel::scene::{QueryStats, SceneGeometry, SceneHit};
 use crate::cli::args::TraceArgs;
 use crate::cli::setup::{precision, prepare, thread_pool};
 use crate::formats::LoadError;
 use crate::formats::rays::{RayChunks, RayQuery};
 use crate::geom::Ray;
 use crate::io::write_atomic;
+use crate::kernel::Kernel;
 use crate::scene::Scene;
 
 /// The header line of the contract.
@@ -50,7 +51,7 @@ pub fn run(args: TraceArgs) -> anyhow::Result<ExitCode> {
                     .par_iter()
                     .enumerate()
                     .map(|(i, q)| {
-                        let hit = trace_one(&prepared.geometry, q, &precision)
+                        let hit = trace_one(&prepared.geometry, q, prepared.origin, &precision)
                             .map(|(h, o, d)| (in_contract_terms(&prepared.scene, h), o, d));
                         row(first + i, hit)
                     })
@@ -74,28 +75,32 @@ pub fn run(args: TraceArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Intersects one query. The `f32` path rounds the ray once to `f32`; the `f64` path uses
-/// it as read. Returns the hit and the origin and direction the hit point refers to.
+/// Intersects one query with `geometry`, which is the scene moved by minus `origin` (the
+/// floating origin, [`crate::scene::origin`]): the ray's origin is moved in `f64`, then the
+/// `f32` path rounds the ray once to `f32`; the `f64` path uses it as moved. Returns the
+/// hit and the world origin and direction the hit point refers to.
 fn trace_one(
     geometry: &SceneGeometry,
     q: &RayQuery,
-    precision: &Precision,
+    origin: DVec3,
+    precision: &Kernel,
 ) -> Option<(SceneHit, DVec3, DVec3)> {
     let mut stats = QueryStats::default();
+    let moved = q.origin - origin;
     match precision {
-        Precision::F32(_) | Precision::Toth(_) | Precision::Cached(_) => {
+        Kernel::F32(_) | Kernel::Toth(_) | Kernel::Cached(_) => {
             let ray = Ray {
-                origin: q.origin.as_vec3(),
+                origin: moved.as_vec3(),
                 dir: q.dir.as_vec3(),
                 tmin: q.tmin as f32,
                 tmax: q.tmax as f32,
             };
             let hit = geometry.intersect(&ray, precision, &mut stats)?;
-            Some((hit, ray.origin.as_dvec3(), ray.dir.as_dvec3()))
+            Some((hit, ray.origin.as_dvec3() + origin, ray.dir.as_dvec3()))
         }
-        Precision::F64(cfg) => {
-            let hit = geometry.intersect_f64(q.origin, q.dir, q.tmin, q.tmax, cfg, &mut stats)?;
-            Some((hit, q.origin, q.dir))
+        Kernel::F64(cfg) => {
+            let hit = geometry.intersect_f64(moved, q.dir, q.tmin, q.tmax, cfg, &mut stats)?;
+            Some((hit, moved + origin, q.dir))
         }
     }
 }

@@ -15,7 +15,6 @@
 //!   and the other's is 0 (background), counted when both images carry alpha.
 
 pub mod flip;
-pub mod heatmap;
 pub mod image;
 pub mod limit;
 pub mod metrics;

@@ -17,6 +17,7 @@ pub enum InputKind {
     Obj,
     Pbrt,
     Gltf,
+    Stl,
     Iges,
     Step,
 }
@@ -30,6 +31,7 @@ impl InputKind {
             "obj" => InputKind::Obj,
             "pbrt" => InputKind::Pbrt,
             "gltf" | "glb" => InputKind::Gltf,
+            "stl" => InputKind::Stl,
             "igs" | "iges" => InputKind::Iges,
             "step" | "stp" => InputKind::Step,
             _ => return None,
@@ -40,7 +42,7 @@ impl InputKind {
 fn unknown_kind(path: &Path) -> LoadError {
     LoadError::invalid(
         path,
-        "unknown file type: expected .ron (scene), .bpt, .obj, .pbrt, .gltf, .glb, .igs, .iges, .step or .stp",
+        "unknown file type: expected .ron (scene), .bpt, .obj, .pbrt, .gltf, .glb, .stl, .igs, .iges, .step or .stp",
     )
 }
 
@@ -73,6 +75,7 @@ pub fn load_geometry_noted(path: &Path) -> Result<(Geometry, Vec<String>), LoadE
             Ok(Geometry::Surfaces(pbrt::parse_pbrt(path, &src)?))
         }
         InputKind::Gltf => Ok(Geometry::Mesh(gltf_mesh::read_gltf(path)?)),
+        InputKind::Stl => Ok(Geometry::Mesh(super::stl::read_stl(path)?)),
         InputKind::Iges => Ok(Geometry::Surfaces(
             read_iges_warning(path)?
                 .surfaces
@@ -123,7 +126,7 @@ pub fn load_subdivision(path: &Path) -> Result<Geometry, LoadError> {
         LoadError::invalid(
             path,
             format!(
-                "{what} is not a polygon mesh, so it cannot be a Catmull–Clark cage; expected an OBJ file of `f` faces, or glTF"
+                "{what} is not a polygon mesh, so it cannot be a Catmull–Clark cage; expected an OBJ file of `f` faces, glTF or STL"
             ),
         )
     };
@@ -138,6 +141,10 @@ pub fn load_subdivision(path: &Path) -> Result<Geometry, LoadError> {
         InputKind::Gltf => Ok(Geometry::Subdivision(cage::mesh_cage(
             path,
             &gltf_mesh::read_gltf(path)?,
+        )?)),
+        InputKind::Stl => Ok(Geometry::Subdivision(cage::mesh_cage(
+            path,
+            &super::stl::read_stl(path)?,
         )?)),
         InputKind::Bpt => Err(refuse("a .bpt file of Bézier patches")),
         InputKind::Pbrt => Err(refuse("a pbrt file")),

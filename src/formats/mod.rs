@@ -1,7 +1,7 @@
 //! Readers and writers of every file format, apart from the scene model they produce
 //! ([`crate::scene`]): our RON scene, `.bpt` Bézier patch files, Wavefront OBJ (free-form
 //! surfaces with trims, and polygon meshes or Catmull–Clark cages), pbrt-v3
-//! `Shape "nurbs"`, glTF and GLB meshes, `trace` ray files, and the CAD exchange formats
+//! `Shape "nurbs"`, glTF and GLB meshes, STL meshes (ASCII and binary), `trace` ray files, and the CAD exchange formats
 //! IGES and STEP ([`cad`]). Every reader reports errors as `file:line:col: what was
 //! expected` (or the byte offset, record or entity of a binary or CAD file); every writer
 //! writes to a temporary name and renames ([`crate::io`]).
@@ -25,6 +25,7 @@ pub mod rays;
 pub mod ron_format;
 pub mod ron_locate;
 pub mod source_key;
+pub mod stl;
 pub mod text;
 pub mod write;
 

@@ -60,6 +60,14 @@ impl Aabb {
         self.max - self.min
     }
 
+    /// The same box in `f64` (exact: every `f32` is an `f64`).
+    pub fn to_f64(&self) -> DAabb {
+        DAabb {
+            min: self.min.as_dvec3(),
+            max: self.max.as_dvec3(),
+        }
+    }
+
     pub fn center(&self) -> Vec3 {
         (self.min + self.max) * 0.5
     }
@@ -69,14 +77,6 @@ impl Aabb {
     pub fn l1_diameter(&self) -> f32 {
         let e = self.extent();
         e.x + e.y + e.z
-    }
-
-    pub fn surface_area(&self) -> f32 {
-        if self.is_empty() {
-            return 0.0;
-        }
-        let e = self.extent();
-        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
     }
 
     pub fn contains(&self, p: Vec3) -> bool {
@@ -312,10 +312,7 @@ mod tests {
         let d = Vec3::new(0.0, 1.0, 0.0);
         let (t0, _) = b.intersect(o, d.recip(), 0.0, f32::INFINITY).expect("hit");
         assert_eq!(t0, 7.0);
-        let db = DAabb {
-            min: b.min.as_dvec3(),
-            max: b.max.as_dvec3(),
-        };
+        let db = b.to_f64();
         let (t0, _) = db
             .intersect(o.as_dvec3(), d.as_dvec3().recip(), 0.0, f64::INFINITY)
             .expect("hit");

@@ -11,6 +11,7 @@ pub mod bezier;
 pub mod bicubic;
 pub mod interval;
 pub mod nurbs;
+pub mod pcurve;
 pub mod ray;
 pub mod real;
 pub mod subdiv;

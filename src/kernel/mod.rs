@@ -6,7 +6,11 @@
 //! - [`toth`]: Toth's interval Newton with Krawczyk's operator (LG90 §4.1, §6).
 //! - [`cached`]: the same tests on regular quadtrees, with each patch's surface tree kept
 //!   in a per-thread LRU cache (LG90 §4.2–4.3).
+//! - [`triangle`]: the watertight ray–triangle test (Woop et al. 2013), four triangles
+//!   at a time.
 //! - [`secondary`]: origins of secondary rays at hit-box corners, §2.4.
+//!
+//! [`Kernel`] selects one for a query; the accelerator passes it down to each patch.
 
 pub mod cached;
 pub mod secondary;
@@ -15,6 +19,52 @@ pub mod toth;
 pub mod triangle;
 
 use crate::geom::Aabb;
+use cached::CachedConfig;
+use subdivision::SubdivisionConfig;
+use toth::TothConfig;
+
+/// Which kernel answers a query: the enum every layer above passes down to select it.
+#[derive(Clone, Copy, Debug)]
+pub enum Kernel {
+    /// The float-precision kernel (Dammertz §2.3) in `f32`.
+    F32(SubdivisionConfig),
+    /// The same algorithm in `f64`: the accuracy reference.
+    F64(SubdivisionConfig),
+    /// Toth's interval Newton kernel (LG90 §4.1) on the `f64` patches, `f32` rays.
+    Toth(TothConfig),
+    /// The cached surface-tree kernel (LG90 §4.2–4.3) on the `f64` patches, `f32` rays.
+    Cached(CachedConfig),
+}
+
+impl Kernel {
+    /// The path for secondary rays: the same, with adaptive termination (defined by the
+    /// camera's pixels) replaced by float precision.
+    pub fn for_secondary_rays(self) -> Kernel {
+        match self {
+            Kernel::F32(cfg) => Kernel::F32(cfg.for_secondary_rays()),
+            Kernel::F64(cfg) => Kernel::F64(cfg.for_secondary_rays()),
+            other @ (Kernel::Toth(_) | Kernel::Cached(_)) => other,
+        }
+    }
+
+    /// The path for secondary rays leaving a hit: [`Kernel::for_secondary_rays`], and
+    /// for the LG90 kernels with ISRT (LG90 §6, "improved treatment of secondary rays")
+    /// the surface of origin (its primitive number, `None` for a triangle), on which they
+    /// apply the triviality tests.
+    pub fn leaving(self, origin: Option<u32>) -> Kernel {
+        match self.for_secondary_rays() {
+            Kernel::Toth(cfg) if cfg.isrt => Kernel::Toth(TothConfig {
+                surface_of_origin: origin,
+                ..cfg
+            }),
+            Kernel::Cached(mut cfg) if cfg.toth.isrt => {
+                cfg.toth.surface_of_origin = origin;
+                Kernel::Cached(cfg)
+            }
+            other => other,
+        }
+    }
+}
 
 /// A hit on one patch: `t` at the entry of the final box, (u, v) the centre of the final
 /// parameter interval in the patch's own [0,1]², and the final box itself (the hit

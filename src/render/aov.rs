@@ -62,8 +62,14 @@ pub fn needs_hits(aovs: &[Aov]) -> bool {
     aovs.iter().any(|&a| a != Aov::Effort)
 }
 
-/// The channels of `aovs` (expanded) over the rendered window.
-pub fn channels(aovs: &[Aov], rendered: &Rendered) -> Vec<AnyChannel<FlatSamples>> {
+/// The channels of `aovs` (expanded) over the rendered window of a scene rendered moved
+/// by minus `origin` (its floating origin, [`crate::scene::origin`]): positions are
+/// reported in world space, `origin` added back in `f64`.
+pub fn channels(
+    aovs: &[Aov],
+    rendered: &Rendered,
+    origin: glam::DVec3,
+) -> Vec<AnyChannel<FlatSamples>> {
     let hits = &rendered.hits;
     let f32s = |name: &str, f: &dyn Fn(&CentreHit) -> f64, miss: f32| {
         let v = hits
@@ -81,9 +87,9 @@ pub fn channels(aovs: &[Aov], rendered: &Rendered) -> Vec<AnyChannel<FlatSamples
         match aov {
             Aov::Depth => out.push(f32s("Z", &|h| h.hit.t, f32::INFINITY)),
             Aov::Position => out.extend([
-                f32s("P.X", &|h| h.point.x, 0.0),
-                f32s("P.Y", &|h| h.point.y, 0.0),
-                f32s("P.Z", &|h| h.point.z, 0.0),
+                f32s("P.X", &|h| h.point.x + origin.x, 0.0),
+                f32s("P.Y", &|h| h.point.y + origin.y, 0.0),
+                f32s("P.Z", &|h| h.point.z + origin.z, 0.0),
             ]),
             Aov::Normal => out.extend([
                 f32s("N.X", &|h| h.hit.normal.x, 0.0),

@@ -155,7 +155,7 @@ pub fn write_effort_png(
     let values: Vec<f32> = effort.iter().map(|&e| e as f32).collect();
     let max = values.iter().copied().fold(1.0f32, f32::max).ln_1p();
     let normalized: Vec<f32> = values.iter().map(|v| v.ln_1p() / max).collect();
-    crate::diff::heatmap::heat_map(&normalized, width, height).write_png(&png_path)?;
+    super::heatmap::heat_map(&normalized, width, height).write_png(&png_path)?;
     Ok(png_path)
 }
 

@@ -9,15 +9,15 @@ use glam::{Vec3, Vec4};
 
 use super::plan::{EffectPlan, MAX_TREE_RAYS};
 use super::stats::{RayKind, RayTally};
-use crate::accel::scene::{Precision, QueryStats, SceneGeometry};
+use crate::accel::scene::{QueryStats, SceneGeometry, SceneHit};
 use crate::geom::Ray;
-use crate::kernel::secondary::secondary_origin;
+use crate::kernel::Kernel;
 use crate::scene::{Light, Scene};
 
 /// Settings that apply to every ray of a render.
 #[derive(Clone, Copy, Debug)]
 pub struct TraceSettings {
-    pub precision: Precision,
+    pub precision: Kernel,
     /// Ulps by which secondary ray origins are pushed off the hit box (Dammertz §2.4.2).
     pub ulps: u32,
     pub plan: EffectPlan,
@@ -67,7 +67,7 @@ impl Integrator<'_> {
     fn secondary(
         &self,
         ray: &Ray,
-        precision: &Precision,
+        precision: &Kernel,
         kind: RayKind,
         (from, coefficient): (Branch, f32),
         work: &mut Work,
@@ -84,12 +84,12 @@ impl Integrator<'_> {
     }
 
     /// Radiance along `ray`, traced by `precision` (for secondary rays,
-    /// [`Precision::leaving`] the surface they start on), which is of the given kind at
+    /// [`Kernel::leaving`] the surface they start on), which is of the given kind at
     /// `branch` of its tree, and whether it hit anything.
     fn radiance(
         &self,
         ray: &Ray,
-        precision: &Precision,
+        precision: &Kernel,
         kind: RayKind,
         branch: Branch,
         work: &mut Work,
@@ -121,10 +121,10 @@ impl Integrator<'_> {
         let plan = &self.settings.plan;
         let ulps = self.settings.ulps;
         let opaque = 1.0 - m.transmit.min(1.0);
-        let leaving = self.settings.precision.leaving(&hit);
+        let leaving = self.settings.precision.leaving(hit.primitive);
 
         let mut color = self.scene.ambient * m.diffuse * opaque;
-        let above = secondary_origin(&hit.leave_box, n_out, true, ulps);
+        let above = hit.secondary_origin(n_out, true, ulps);
         for light in &self.scene.lights {
             let (to_light, tmax, intensity) = match *light {
                 Light::Point {
@@ -181,7 +181,7 @@ impl Integrator<'_> {
                     n_out,
                     outside,
                     m.ior,
-                    (&hit.leave_box, &leaving),
+                    (&hit, &leaving),
                     (branch, m.transmit),
                     work,
                 );
@@ -194,7 +194,7 @@ impl Integrator<'_> {
     /// Light through a transmissive surface: refraction weighted by 1 − Fresnel, plus the
     /// Fresnel reflection; all reflection under total internal reflection. `n` is the
     /// shading normal and `n_out` the geometric one, both on the incoming side; the rays
-    /// leave `leave_box` and are traced by `leaving`, from `from`, scaled by `transmit`.
+    /// leave `hit` and are traced by `leaving`, from `from`, scaled by `transmit`.
     #[allow(clippy::too_many_arguments)]
     fn transmitted(
         &self,
@@ -203,7 +203,7 @@ impl Integrator<'_> {
         n_out: Vec3,
         entering: bool,
         ior: f32,
-        (leave_box, leaving): (&crate::geom::Aabb, &Precision),
+        (hit, leaving): (&SceneHit, &Kernel),
         (from, transmit): (Branch, f32),
         work: &mut Work,
     ) -> Vec3 {
@@ -211,10 +211,7 @@ impl Integrator<'_> {
         let eta = if entering { 1.0 / ior } else { ior };
         let cos_i = -d.dot(n);
         let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
-        let reflected = Ray::new(
-            secondary_origin(leave_box, n_out, true, ulps),
-            reflect(d, n),
-        );
+        let reflected = Ray::new(hit.secondary_origin(n_out, true, ulps), reflect(d, n));
         if k < 0.0 {
             let weight = (from, transmit);
             return self.secondary(&reflected, leaving, RayKind::Reflection, weight, work);
@@ -223,7 +220,7 @@ impl Integrator<'_> {
         // Schlick uses the cosine on the optically thinner side.
         let cos = if entering { cos_i } else { k.sqrt() };
         let f = schlick(cos, ior);
-        let refracted = Ray::new(secondary_origin(leave_box, n_out, false, ulps), t_dir);
+        let refracted = Ray::new(hit.secondary_origin(n_out, false, ulps), t_dir);
         let weight = (from, transmit * (1.0 - f));
         let through = self.secondary(&refracted, leaving, RayKind::Refraction, weight, work);
         let weight = (from, transmit * f);

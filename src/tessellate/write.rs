@@ -22,6 +22,7 @@ pub enum MeshFormat {
     Obj,
     Gltf,
     Glb,
+    Stl,
 }
 
 impl MeshFormat {
@@ -31,6 +32,7 @@ impl MeshFormat {
             "obj" => Some(MeshFormat::Obj),
             "gltf" => Some(MeshFormat::Gltf),
             "glb" => Some(MeshFormat::Glb),
+            "stl" => Some(MeshFormat::Stl),
             _ => None,
         }
     }
@@ -43,7 +45,7 @@ pub fn write_mesh_scene(path: &Path, scene: &Scene) -> Result<u64, OutputError> 
     let format = MeshFormat::of(path).ok_or_else(|| {
         OutputError::invalid(
             path,
-            "unsupported mesh output: expected .obj, .gltf or .glb",
+            "unsupported mesh output: expected .obj, .gltf, .glb or .stl",
         )
     })?;
     let mut meshes = Vec::with_capacity(scene.objects.len());
@@ -63,6 +65,7 @@ pub fn write_mesh_scene(path: &Path, scene: &Scene) -> Result<u64, OutputError> 
     }
     match format {
         MeshFormat::Obj => write_atomic(path, |w| write_obj(w, &meshes))?,
+        MeshFormat::Stl => write_atomic(path, |w| crate::formats::stl::write_stl(w, &meshes))?,
         MeshFormat::Gltf | MeshFormat::Glb => {
             let bytes = gltf_bytes(&meshes, format == MeshFormat::Glb)
                 .map_err(|m| OutputError::invalid(path, m))?;

@@ -127,3 +127,82 @@ fn tessellate_writes_each_format_and_reports_counts() {
     assert_ne!(o.status.code(), Some(0));
     assert!(stderr(&o).contains("even count"), "{}", stderr(&o));
 }
+
+/// `compare --tolerance` tessellates by chord height as `tessellate --tolerance` does, and
+/// `--against` a mesh file of that same tessellation (written as OBJ with its normals, read
+/// back) renders the same pixels as the in-memory tessellation: two paths to one image.
+#[test]
+fn chord_tolerances_and_a_mesh_from_elsewhere_take_their_rows() {
+    let dir = tempfile::tempdir().unwrap();
+    let teapot = testdata("teapot.bpt");
+    let mesh_file = dir.path().join("teapot.obj");
+    let o = run(&[
+        "tessellate",
+        teapot.to_str().unwrap(),
+        "-o",
+        mesh_file.to_str().unwrap(),
+        "--tolerance",
+        "0.05",
+        "--json",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let out = dir.path().join("cmp");
+    let o = run(&[
+        "compare",
+        teapot.to_str().unwrap(),
+        "--tolerance",
+        "0.05mm",
+        "--against",
+        mesh_file.to_str().unwrap(),
+        "--out-dir",
+        out.to_str().unwrap(),
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let csv = std::fs::read_to_string(out.join("compare.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    // The direct render, the chord row, the mesh from the file; no default triangle rows.
+    assert_eq!(rows.len(), 3, "{csv}");
+    assert_eq!(rows[1][0], "chord 0.05 mm");
+    assert_eq!(rows[2][0], "teapot.obj");
+    let triangles = report["triangles"].as_u64().unwrap().to_string();
+    assert_eq!(rows[1][1], triangles, "{csv}");
+    assert_eq!(rows[2][1], triangles, "{csv}");
+    // One material in the bare teapot: the same reference, the same pixels, the same error.
+    assert_eq!(rows[1][5..9], rows[2][5..9], "{csv}");
+    assert_ne!(rows[1][6], "inf", "{csv}");
+    for f in [
+        "chord5.000e-2.png",
+        "flip-chord5.000e-2.png",
+        "against0.png",
+        "direct-plain.png",
+    ] {
+        assert!(out.join(f).exists(), "{f} missing");
+    }
+    // A tolerance that is not a length, and a file that is not a mesh, are bad input.
+    for extra in [
+        ["--tolerance", "0"],
+        ["--against", teapot.to_str().unwrap()],
+    ] {
+        let mut args = vec!["compare", teapot.to_str().unwrap(), "-q"];
+        args.extend_from_slice(&extra);
+        args.extend_from_slice(&["--out-dir", out.to_str().unwrap()]);
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", stderr(&o));
+        assert!(
+            stderr(&o).contains(extra[0]) || stderr(&o).contains("mesh"),
+            "{}",
+            stderr(&o)
+        );
+    }
+}

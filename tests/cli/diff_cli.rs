@@ -6,7 +6,7 @@ use crate::common;
 use std::path::{Path, PathBuf};
 
 use common::{run, stderr, stdout};
-use patchtrace::diff::heatmap::LEGEND_HEIGHT;
+use patchtrace::render::heatmap::LEGEND_HEIGHT;
 
 const W: u32 = 32;
 const H: u32 = 24;

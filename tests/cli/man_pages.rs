@@ -1,5 +1,5 @@
 //! The man pages in `man/` are generated from the clap definitions; this fails when they
-//! are stale. Regenerate with `PATCHTRACE_UPDATE_MAN=1 cargo test --test man_pages`.
+//! are stale. Regenerate with `PATCHTRACE_UPDATE_MAN=1 cargo test --test cli man_pages`.
 
 use std::path::Path;
 
@@ -22,7 +22,7 @@ fn man_pages_match_the_command_line_definitions() {
     }
     assert!(
         stale.is_empty(),
-        "stale or missing man pages: {stale:?}; run PATCHTRACE_UPDATE_MAN=1 cargo test --test man_pages"
+        "stale or missing man pages: {stale:?}; run PATCHTRACE_UPDATE_MAN=1 cargo test --test cli man_pages"
     );
     // Every subcommand has a page and no page is left over from a removed command.
     let on_disk = std::fs::read_dir(&dir).unwrap().count();

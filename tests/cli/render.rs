@@ -15,6 +15,14 @@ fn stats(scene: &str, extra: &[&str]) -> serde_json::Value {
     serde_json::from_str(&stdout(&o)).expect("stats JSON")
 }
 
+/// Whether this machine runs the AVX-512 bicubic path, the one that searches in ray space.
+fn ray_space_kernel() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    return patchtrace::kernel::subdivision::avx512::available();
+    #[cfg(not(target_arch = "x86_64"))]
+    false
+}
+
 #[test]
 fn ray_counts_by_type_follow_the_effect_plan() {
     // Reflective teapot, one light: shadows and reflection, no refraction.
@@ -24,8 +32,10 @@ fn ray_counts_by_type_follow_the_effect_plan() {
     assert!(s["rays"]["reflection"].as_u64().unwrap() > 0);
     assert_eq!(s["rays"]["refraction"], 0);
     assert_eq!(s["plan"]["refraction"], false);
-    // Primary rays search the patches in ray space, where the kernel jumps.
-    assert!(s["rays"]["jumps_per_ray"]["mean"].as_f64().unwrap() > 0.0);
+    // On AVX-512 primary rays search the bicubic patches in ray space, where the kernel
+    // jumps; the portable path searches in world space and never jumps.
+    let jumps = s["rays"]["jumps_per_ray"]["mean"].as_f64().unwrap();
+    assert_eq!(jumps > 0.0, ray_space_kernel(), "jumps per ray {jumps}");
 
     // Glass: refraction rays appear.
     let s = stats("glass_teapot.ron", &[]);
@@ -174,4 +184,24 @@ fn effort_aov_counts_every_split_of_the_render() {
     // The top-left pixel sees only background: no patch, no split.
     assert_eq!(values[0], 0.0);
     assert!(dir.path().join("e-effort.png").exists());
+}
+
+/// A flag the command cannot honour is bad input: exit status 2, the flag named, no image.
+#[test]
+fn flags_the_command_cannot_honour_exit_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("x.png");
+    let scene = testdata("teapot.ron");
+    for (extra, named) in [
+        (&["--crop", "0,4000,0,10"][..], "--crop"),
+        (&["--tile", "3/2"][..], "tile"),
+        (&["--bvh", "absent.bvh", "--accel", "grid"][..], "--bvh"),
+        (&["--isrt"][..], "--isrt"),
+    ] {
+        let o = render(&scene, &out, (16, 16), extra);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {err}");
+        assert!(err.contains(named), "{extra:?}: {err}");
+        assert!(!out.exists(), "{extra:?} wrote an image");
+    }
 }

@@ -15,10 +15,11 @@ use common::{render, run, stderr, testdata, trace_rows};
 use glam::Vec3;
 use patchtrace::accel::bvh::{Bvh, checksum};
 use patchtrace::accel::mapped;
-use patchtrace::accel::scene::{FromFile, Precision, QueryStats, SceneGeometry};
+use patchtrace::accel::scene::{FromFile, QueryStats, SceneGeometry};
 use patchtrace::formats::ron_format::parsed_scene;
 use patchtrace::formats::{LoadOptions, load_scene_keyed};
 use patchtrace::geom::{Aabb, Ray};
+use patchtrace::kernel::Kernel;
 use patchtrace::kernel::subdivision::SubdivisionConfig;
 
 /// Three teapots from one `.bpt` file, each placed by its own transform (so 96 distinct
@@ -163,7 +164,7 @@ fn layout(bytes: &[u8]) -> (usize, usize, usize, usize, usize) {
     let word = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().unwrap()) as usize;
     let (nodes, prims) = (word(20), word(28));
     let section = (36 + 32 * nodes + 4 * prims + 8).next_multiple_of(8);
-    let records = section + 32;
+    let records = section + 56;
     let end = records + word(section + 8) * mapped::RECORD_BYTES;
     let scene = end + 8;
     (
@@ -235,7 +236,7 @@ fn truncated_and_damaged_files_are_refused_with_the_byte_offset() {
     // Random damage to the patch section, resealed: never a panic, and geometry from a
     // file that is accepted answers queries without one (in-process, so a panic fails).
     let mut rng = Rng::new(19);
-    let precision = Precision::F32(SubdivisionConfig::default());
+    let precision = Kernel::F32(SubdivisionConfig::default());
     let path = dir.path().join("forged.bvh");
     for _ in 0..40 {
         let mut bytes = good.clone();

@@ -6,10 +6,11 @@ use std::collections::{HashMap, HashSet};
 
 use glam::{DVec3, Vec3};
 use patchtrace::accel::grid::{DEFAULT_BUDGET_BYTES, Grid};
-use patchtrace::accel::scene::{Precision, QueryStats, SceneGeometry};
+use patchtrace::accel::scene::{QueryStats, SceneGeometry};
 use patchtrace::formats::load_scene;
 use patchtrace::geom::ulp::ulp_distance;
 use patchtrace::geom::{BezierPatch, DAabb, Ray};
+use patchtrace::kernel::Kernel;
 use patchtrace::kernel::subdivision::SubdivisionConfig;
 use patchtrace::kernel::triangle::{RayShear, intersect_triangle};
 use patchtrace::scene::Scene;
@@ -63,11 +64,7 @@ fn random_ray(rng: &mut SplitMix64, b: &DAabb) -> Ray {
 }
 
 fn scene_box(g: &SceneGeometry) -> DAabb {
-    let b = g.bounds();
-    DAabb {
-        min: b.min.as_dvec3(),
-        max: b.max.as_dvec3(),
-    }
+    g.bounds().to_f64()
 }
 
 #[test]
@@ -76,7 +73,7 @@ fn grid_and_bvh_find_the_same_nearest_hits_on_100_teapots() {
     let bvh = SceneGeometry::build(&scene);
     let grid = SceneGeometry::build_grid(&scene, DEFAULT_BUDGET_BYTES);
     assert!(grid.grid().is_some() && bvh.bvh().is_some());
-    let precision = Precision::F32(SubdivisionConfig::default());
+    let precision = Kernel::F32(SubdivisionConfig::default());
     let mut rng = SplitMix64::new(5);
     let bounds = scene_box(&bvh);
     let (mut hits, mut ties) = (0, 0);

@@ -35,6 +35,7 @@ mod robust_parsers;
 mod stability_suite;
 mod step_assembly;
 mod step_entities;
+mod step_faces;
 mod step_part;
 mod subdiv_surface;
 mod subdiv_tessellate;

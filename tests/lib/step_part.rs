@@ -233,7 +233,13 @@ fn unsupported_entities_are_counted_and_faces_named() {
     let mut w = step_support::StepWriter::default();
     let ax = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
     let plane = w.add(format!("PLANE('',#{ax})"));
-    let offset = w.add(format!("OFFSET_SURFACE('',#{plane},1.,.F.)"));
+    // An offset of an extrusion, which is not read (offsets of the elementary surfaces
+    // are, as the elementary surface they are).
+    let line = w.line(DVec3::ZERO, DVec3::X);
+    let up = w.dir(DVec3::Y);
+    let v = w.add(format!("VECTOR('',#{up},1.)"));
+    let ext = w.add(format!("SURFACE_OF_LINEAR_EXTRUSION('',#{line},#{v})"));
+    let offset = w.add(format!("OFFSET_SURFACE('',#{ext},1.,.F.)"));
     let sq = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
     let b = w.polygon_bound(&sq, true);
     let bad = w.face(&[b], offset);

@@ -8,9 +8,10 @@ use crate::subdiv_common;
 
 use glam::DVec3;
 use patchtrace::accel::grid::DEFAULT_BUDGET_BYTES;
-use patchtrace::accel::scene::{Precision, QueryStats, SceneGeometry};
+use patchtrace::accel::scene::{QueryStats, SceneGeometry};
 use patchtrace::geom::Ray;
 use patchtrace::geom::ulp::ulp_of;
+use patchtrace::kernel::Kernel;
 use patchtrace::kernel::subdivision::SubdivisionConfig;
 use patchtrace::scene::generate::SplitMix64;
 use patchtrace::scene::{Geometry, Object, Scene};
@@ -150,7 +151,7 @@ fn f32_ray(origin: DVec3, dir: DVec3) -> Ray {
 /// Shoots along -n at each target from `distance` away; returns the hit errors in ulps of
 /// the target's largest coordinate, and the number of misses.
 fn aimed_errors(g: &SceneGeometry, targets: &[Target], distance: f64) -> (Vec<f64>, usize) {
-    let precision = Precision::F32(SubdivisionConfig::default());
+    let precision = Kernel::F32(SubdivisionConfig::default());
     let mut errors = Vec::new();
     let mut misses = 0;
     for t in targets {
@@ -266,7 +267,7 @@ fn no_holes_at_shared_edges_and_extraordinary_vertices() {
         };
         let mut targets = global_targets(&cage, 3, &radial);
         targets.extend(near_extraordinary_targets(&cage, 10, &radial));
-        let precision = Precision::F32(SubdivisionConfig::default());
+        let precision = Kernel::F32(SubdivisionConfig::default());
         let mut rng = SplitMix64::new(20);
         let (mut holes, mut late) = (0, 0);
         let rays = 3_334;
@@ -316,7 +317,7 @@ fn bvh_keeps_the_patch_a_ray_grazes_at_a_shared_edge() {
         tmax: f32::INFINITY,
     };
     let aimed = DVec3::new(-0.2576694811213545, 0.2576694811213545, 0.2336680652564336);
-    let precision = Precision::F32(SubdivisionConfig::default());
+    let precision = Kernel::F32(SubdivisionConfig::default());
     let h = g
         .intersect(&ray, &precision, &mut QueryStats::default())
         .expect("the ray hits the cube's surface");

@@ -3,10 +3,11 @@
 //! against an `f64` point-in-polygon test of the test's own.
 
 use glam::{DVec2, DVec3, DVec4, Vec3};
-use patchtrace::accel::scene::{Precision, QueryStats, SceneGeometry};
+use patchtrace::accel::scene::{QueryStats, SceneGeometry};
 use patchtrace::geom::nurbs::NurbsSurface;
 use patchtrace::geom::trim::{ParamCurve, TrimLoop};
 use patchtrace::geom::{BezierPatch, Ray};
+use patchtrace::kernel::Kernel;
 use patchtrace::kernel::cached::CachedConfig;
 use patchtrace::kernel::subdivision::SubdivisionConfig;
 use patchtrace::kernel::toth::TothConfig;
@@ -46,14 +47,14 @@ fn scene_of(surface: Surface) -> Scene {
     }])
 }
 
-fn precisions() -> Vec<(&'static str, Precision)> {
+fn precisions() -> Vec<(&'static str, Kernel)> {
     vec![
-        ("f32", Precision::F32(SubdivisionConfig::default())),
-        ("f64", Precision::F64(SubdivisionConfig::default())),
-        ("toth", Precision::Toth(TothConfig::default())),
+        ("f32", Kernel::F32(SubdivisionConfig::default())),
+        ("f64", Kernel::F64(SubdivisionConfig::default())),
+        ("toth", Kernel::Toth(TothConfig::default())),
         (
             "cached",
-            Precision::Cached(CachedConfig::new(TothConfig::default(), 1 << 20, 6)),
+            Kernel::Cached(CachedConfig::new(TothConfig::default(), 1 << 20, 6)),
         ),
     ]
 }

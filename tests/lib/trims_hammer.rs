@@ -8,10 +8,11 @@
 use std::path::Path;
 
 use glam::{DVec2, DVec3};
-use patchtrace::accel::scene::{Precision, QueryStats, SceneGeometry};
+use patchtrace::accel::scene::{QueryStats, SceneGeometry};
 use patchtrace::formats::load_scene;
 use patchtrace::geom::Ray;
 use patchtrace::geom::trim::{ParamCurve, TrimLoop};
+use patchtrace::kernel::Kernel;
 use patchtrace::scene::{Geometry, SurfaceGeometry};
 
 const HAMMER: &str = "testdata/gismo/hammer.from_iges.obj";
@@ -108,7 +109,7 @@ fn hammer_rays_hit_trimmed_faces_and_pass_where_loops_cut_away() {
     // (another face in front, a sliver surface folding near it), the point says nothing
     // about trims and is not used.
     let untrimmed = SceneGeometry::build(&scene.clone().without_trims());
-    let precision = Precision::F32(Default::default());
+    let precision = Kernel::F32(Default::default());
     let Geometry::Surfaces(surfaces) = &scene.objects[0].geometry else {
         panic!("the hammer is free-form");
     };

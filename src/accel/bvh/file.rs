@@ -33,8 +33,9 @@ pub const MAGIC: [u8; 8] = *b"\x89PTBVH\r\n";
 /// The format version this build writes and reads. Version 2 keys the file by
 /// its inputs' bytes, checksums with xxh3 and appends the prepared patches; version 3
 /// adds to each patch record where a subdivision surface's patch lies in its
-/// quad, which `trace` reports.
-pub const FORMAT_VERSION: u32 = 3;
+/// quad, which `trace` reports; version 4 records the floating origin the geometry was
+/// built at (`crate::scene::origin`).
+pub const FORMAT_VERSION: u32 = 4;
 
 const HEADER_LEN: usize = 36;
 const NODE_WORDS: usize = size_of::<Node>() / 4;

@@ -14,9 +14,10 @@ use std::time::Instant;
 use glam::DVec3;
 use serde::Serialize;
 
-use crate::accel::scene::{Precision, QueryStats, SceneGeometry, SceneHit};
+use crate::accel::scene::{QueryStats, SceneGeometry, SceneHit};
 use crate::formats::rays::RayQuery;
-use crate::geom::{DAabb, Ray};
+use crate::geom::Ray;
+use crate::kernel::Kernel;
 use crate::kernel::cached::CachedConfig;
 use crate::kernel::subdivision::{SplitHeuristic, SubdivisionConfig, Termination};
 use crate::kernel::toth::TothConfig;
@@ -80,11 +81,11 @@ impl Method {
 
     /// The kernel path of the method. `camera` sizes the pixels of adaptive termination;
     /// a tessellation has no patches left, so the default is as good as any.
-    pub fn precision(&self, camera: &Camera) -> Precision {
+    pub fn precision(&self, camera: &Camera) -> Kernel {
         let base = SubdivisionConfig::default();
-        Precision::F32(match *self {
-            Method::Toth => return Precision::Toth(TothConfig::default()),
-            Method::Cached => return Precision::Cached(CachedConfig::default()),
+        Kernel::F32(match *self {
+            Method::Toth => return Kernel::Toth(TothConfig::default()),
+            Method::Cached => return Kernel::Cached(CachedConfig::default()),
             Method::Float(heuristic) => SubdivisionConfig { heuristic, ..base },
             Method::Adaptive => SubdivisionConfig {
                 termination: Termination::Adaptive(CameraRays::new(camera).footprint()),
@@ -171,10 +172,7 @@ struct Reference {
 /// rounding bound. If the box rounds off the ray, the entry point is used.
 fn hit_point(h: &SceneHit, r: &Ray) -> DVec3 {
     let (origin, dir) = (r.origin.as_dvec3(), r.dir.as_dvec3());
-    let b = DAabb {
-        min: h.hit_box.min.as_dvec3(),
-        max: h.hit_box.max.as_dvec3(),
-    };
+    let b = h.hit_box.to_f64();
     let t = b
         .intersect(origin, dir.recip(), r.tmin as f64, f64::INFINITY)
         .map_or(h.t, |(t0, t1)| 0.5 * (t0 + t1));

@@ -12,10 +12,11 @@ use std::path::{Path, PathBuf};
 use indicatif::ProgressBar;
 
 use crate::accel::grid::DEFAULT_BUDGET_BYTES;
-use crate::accel::scene::{Precision, SceneGeometry};
+use crate::accel::scene::SceneGeometry;
 use crate::formats::{LoadError, load_scene};
 use crate::io::OutputError;
 use crate::io::write_atomic;
+use crate::kernel::Kernel;
 use crate::kernel::cached::{CachedConfig, DEFAULT_MAX_DEPTH};
 use crate::kernel::secondary::DEFAULT_ULPS;
 use crate::kernel::toth::TothConfig;
@@ -144,9 +145,9 @@ impl Method {
     /// [`CachedConfig`] empties the workers' caches), so cases do not share trees. The
     /// cached methods include ISRT's treatment of secondary rays, as the paper's do (their
     /// Newton starts per ray equal ISRT's in every table).
-    pub fn precision(&self, cache_bytes: usize) -> Precision {
+    pub fn precision(&self, cache_bytes: usize) -> Kernel {
         let toth = |isrt| {
-            Precision::Toth(TothConfig {
+            Kernel::Toth(TothConfig {
                 isrt,
                 ..TothConfig::default()
             })
@@ -154,7 +155,7 @@ impl Method {
         match self.kernel {
             MethodKernel::Toth => toth(false),
             MethodKernel::Isrt => toth(true),
-            MethodKernel::Cached => Precision::Cached(CachedConfig::new(
+            MethodKernel::Cached => Kernel::Cached(CachedConfig::new(
                 TothConfig {
                     isrt: true,
                     ..TothConfig::default()

@@ -1,7 +1,7 @@
 //! The numerical stability suite: hard cases ([`cases`]) run against every kernel
 //! path and compared ray by ray with the `f64` reference ([`run`]), summarised as a
 //! Markdown or CSV table ([`report`]). The acceptance criteria of the float-precision
-//! kernel are [`Criterion`]s, checked by `tests/stability_suite.rs` on the reduced suite.
+//! kernel are [`Criterion`]s, checked by `tests/lib/stability_suite.rs` on the reduced suite.
 
 pub mod cases;
 pub mod report;

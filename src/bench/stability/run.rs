@@ -28,10 +28,11 @@ use glam::{DVec3, Vec3};
 use indicatif::ProgressBar;
 
 use super::cases::Case;
-use crate::accel::scene::{Precision, QueryStats, SceneGeometry, SceneHit};
+use crate::accel::scene::{QueryStats, SceneGeometry, SceneHit};
 use crate::formats::load::check_f32_range;
 use crate::geom::ulp::ulp_of;
 use crate::geom::{Aabb, BezierPatch, DAabb, Ray};
+use crate::kernel::Kernel;
 use crate::kernel::secondary::{DEFAULT_ULPS, secondary_origin};
 use crate::kernel::subdivision::SubdivisionConfig;
 use crate::render::integrator::{Integrator, TraceSettings};
@@ -71,11 +72,11 @@ impl KernelPath {
     }
 
     /// The query settings of this path.
-    pub fn precision(self) -> Precision {
+    pub fn precision(self) -> Kernel {
         let cfg = SubdivisionConfig::default();
         match self {
-            KernelPath::F32 => Precision::F32(cfg),
-            KernelPath::F64 => Precision::F64(cfg),
+            KernelPath::F32 => Kernel::F32(cfg),
+            KernelPath::F64 => Kernel::F64(cfg),
         }
     }
 
@@ -365,7 +366,7 @@ fn surface_meets_box(patch: &BezierPatch, target: &DAabb, depth: u32) -> bool {
 /// non-finite normals.
 fn secondaries(
     geometry: &SceneGeometry,
-    precision: &Precision,
+    precision: &Kernel,
     ray: &Ray,
     h: &SceneHit,
     rng: &mut SplitMix64,
@@ -426,7 +427,7 @@ fn overlap(a: &Aabb, b: &Aabb) -> bool {
 fn nan_pixels(
     case: &Case,
     geometry: &SceneGeometry,
-    precision: Precision,
+    precision: Kernel,
     size: u32,
 ) -> (usize, usize) {
     let mut scene = case.scene.clone();

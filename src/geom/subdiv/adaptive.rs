@@ -34,8 +34,8 @@ use super::stencil::bezier_stencils;
 use super::topology::{Mesh, Topology};
 use super::{Piece, Stats};
 use crate::geom::BezierPatch;
+use crate::geom::ulp::DEFAULT_END_ULPS;
 use crate::geom::ulp::ulp_of;
-use crate::kernel::subdivision::DEFAULT_END_ULPS;
 
 /// The deepest level: the extraordinary child then spans 2^-48 of its face, and its hull
 /// at most `λ^47` of the face's ring, λ ≤ 0.66 the subdominant eigenvalue of

@@ -177,11 +177,6 @@ impl PatchTrim {
         }
         odd != self.outer_is_domain
     }
-
-    /// Pieces this patch tests in full, and chords it tests by their end points.
-    pub fn piece_counts(&self) -> (usize, usize) {
-        (self.near.len(), self.far.len())
-    }
 }
 
 #[cfg(test)]

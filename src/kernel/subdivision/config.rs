@@ -21,18 +21,12 @@ pub enum SplitHeuristic {
 /// division, so crack freedom does not depend on it and it only ends the end game early.
 /// 16 keeps the box within 16 ulps per coordinate (Dammertz Table 2.12: mean error about
 /// twice that of dist 0). Not yet tuned by measurement: the Newton test
-/// (tests/kernel_newton.rs) passes with it, the split savings are unmeasured.
+/// (tests/lib/kernel_newton.rs) passes with it, the split savings are unmeasured.
 pub const DEFAULT_RATIONAL_DIST: u32 = 16;
 
-/// End-game threshold: a box whose L1 diameter is below this many ulps of the root box's
-/// largest coordinate magnitude is final, besides Dammertz's "stops shrinking" (§2.3.3),
-/// which alone spends the last splits on rounding noise. Measured with
-/// `cargo bench --bench kernel -- size=256 end=K` (teapot primary rays; splits per test,
-/// mean / 99th-percentile hit-point distance to the `f64` reference in those ulps):
-/// K = 0: 78.2, 4.3 / 33; 4: 72.4, 4.5 / 35; 8: 68.2, 4.9 / 37; 16: 64.3, 6.0 / 44.
-/// 8 saves an eighth of the splits for an error still well inside the de Casteljau
-/// rounding bound the tests allow (tests/kernel_newton.rs).
-pub const DEFAULT_END_ULPS: u32 = 8;
+/// End-game threshold of the float-precision criterion: where it is measured and why 8,
+/// see the definition (kept in `geom::ulp`, as load-time refinement measures by it too).
+pub use crate::geom::ulp::DEFAULT_END_ULPS;
 
 /// Splits a ray–patch test takes at full precision before its end game coarsens
 /// ([`SubdivisionConfig::full_precision_splits`]). A ray that runs at a small angle θ to the
@@ -44,7 +38,7 @@ pub const DEFAULT_END_ULPS: u32 = 8;
 /// primary rays take at most 3786 splits per test (`cargo bench --bench kernel`); with
 /// 2560 the few pairs above that coarsened and moved the mean hit error from 13.8 to 27
 /// ulps (max 1.15e6, along a grazing ray). Rational patches converge more slowly (their
-/// boxes come from homogeneous division, §2.7.2): a ray of tests/kernel_newton.rs at a
+/// boxes come from homogeneous division, §2.7.2): a ray of tests/lib/kernel_newton.rs at a
 /// random rational patch needs 7150 splits, and a budget of 4096 moved its hit 1e-3 off
 /// the crossing. 16384 leaves a factor of two above that; the stability suite's worst
 /// unbudgeted test (15251 splits, a folded patch) stays just below it.

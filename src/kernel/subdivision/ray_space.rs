@@ -41,7 +41,7 @@
 //! refraction rays from every hit with the default configuration, so in ray space, and
 //! counts 0 self-hits on every case.
 //!
-//! Precision. The transformed points are rounded to ulps of their distance from the ray
+//! Kernel. The transformed points are rounded to ulps of their distance from the ray
 //! origin, while the world net is exact only to ulps of its own coordinates: the end game
 //! ([`super::search`]) stops at the larger of the two ([`RayFrame::world_length`]), so the
 //! search never refines below the precision of the net it came from.
@@ -77,7 +77,7 @@ pub const TRANSFORM_ULPS: f64 = 8.0;
 /// net lets it through on A's side. Culling A by its world box then loses the hit, or
 /// hands the ray to a surface behind (measured without the margin: 1 ray in 180,000 aimed
 /// at the shared edges and extraordinary vertices of three subdivision surfaces went
-/// through the cube's, `tests/subdiv_surface.rs`). A ray-space coordinate is within [`TRANSFORM_ULPS`]
+/// through the cube's, `tests/lib/subdiv_surface.rs`). A ray-space coordinate is within [`TRANSFORM_ULPS`]
 /// ulps of its exact value at the ray-space scale `|p - o| / |d|`, which is at most two
 /// ulps of `|p - o|` back in world units, on each of the two axes across the ray: within
 /// `2 √2 TRANSFORM_ULPS` ulps (about 22.6) of `|p - o|` of the ray. 32 also covers the

@@ -48,7 +48,7 @@ pub const DEFAULT_FINAL_ULPS: u32 = crate::kernel::subdivision::DEFAULT_END_ULPS
 pub struct TothConfig {
     /// LG90 §6's improved treatment of secondary rays (ISRT): shadow rays stop at the
     /// first safe region, and secondary rays get the triviality tests on their surface of
-    /// origin ([`crate::accel::scene::Precision::leaving`]).
+    /// origin ([`crate::kernel::Kernel::leaving`]).
     pub isrt: bool,
     /// Search iterations per ray–patch test.
     pub max_iterations: u32,
@@ -56,7 +56,7 @@ pub struct TothConfig {
     pub final_ulps: u32,
     /// The accelerator's number of the patch the ray leaves, for secondary rays: the
     /// kernels apply LG90's triviality tests (§6) on that patch. Set per ray by
-    /// [`crate::accel::scene::Precision::leaving`].
+    /// [`crate::kernel::Kernel::leaving`].
     pub surface_of_origin: Option<u32>,
 }
 

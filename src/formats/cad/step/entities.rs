@@ -329,19 +329,158 @@ fn expand_knots(r: &Rec, mult: &Param, knots: &Param) -> Result<Vec<f64>, ParseE
     Ok(out)
 }
 
-/// The knots ISO 10303-42 implies for a BEZIER_CURVE/SURFACE of `count` points: 0 and the
-/// last breakpoint repeated `degree + 1` times, the integers between `degree` times.
-fn bezier_knots(degree: usize, count: usize) -> Option<Vec<f64>> {
-    if degree == 0 || count < degree + 1 || !(count - 1).is_multiple_of(degree) {
-        return None;
+/// Cosine of the largest angle between a LINE and the chord of its edge's vertices for
+/// which a line off its vertices is taken as displaced (cos 4.5e-5 rad): directions
+/// written to four or five digits are that far from the true one.
+const PARALLEL_COS: f64 = 1.0 - 1e-9;
+
+/// An edge's LINE moved to pass through the edge's vertices when it runs parallel to
+/// them but beside them, as OpenCASCADE's reader does (StepToTopoDS_TranslateEdge: some
+/// ECAD writers place an edge's line away from its true position with the right
+/// direction). Any other curve, or a line through its vertices, is returned unchanged.
+fn line_through_vertices(curve: Arc<Curve>, start: DVec3, end: DVec3) -> Arc<Curve> {
+    let shifted = |c: &Curve| -> Option<Curve> {
+        let Curve::Line { origin, direction } = c else {
+            return None;
+        };
+        let d = direction.try_normalize()?;
+        let chord = end - start;
+        let off = {
+            let r = start - *origin;
+            r - r.dot(d) * d
+        };
+        let parallel = chord.dot(d).abs() >= PARALLEL_COS * chord.length();
+        (parallel && off != DVec3::ZERO && chord != DVec3::ZERO).then(|| Curve::Line {
+            origin: *origin + off,
+            direction: *direction,
+        })
+    };
+    match &*curve {
+        Curve::OnSurface { curve: c3, pcurves } => match shifted(c3) {
+            Some(line) => Arc::new(Curve::OnSurface {
+                curve: Arc::new(line),
+                pcurves: pcurves.clone(),
+            }),
+            None => curve,
+        },
+        c => shifted(c).map_or(curve, Arc::new),
     }
-    let pieces = (count - 1) / degree;
-    let mut k = vec![0.0; degree + 1];
-    for s in 1..pieces {
-        k.extend(std::iter::repeat_n(s as f64, degree));
+}
+
+/// OFFSET_SURFACE (ISO 10303-42 §4.4.x: the basis moved by `d` along its unit normal
+/// S_u × S_v) of an elementary surface, exactly, as the elementary surface it is: a plane
+/// moved along its axis, a cylinder, sphere or torus tube of radius r + d, a cone of
+/// radius r + d / cos α about the same frame (its points lie d sin α lower on the axis
+/// than the basis parameter's, so its pcurves, if any, are checked and projected
+/// again). `None` for other bases, or where the offset passes the axis (a radius ≤ 0).
+fn offset_exactly(basis: &SurfaceDef, d: f64) -> Option<SurfaceDef> {
+    let positive = |r: f64| (r > 0.0 && r.is_finite()).then_some(r);
+    Some(match basis {
+        SurfaceDef::Plane(f) => SurfaceDef::Plane(Frame {
+            origin: f.origin + d * f.z,
+            ..*f
+        }),
+        SurfaceDef::Cylinder { frame, radius } => SurfaceDef::Cylinder {
+            frame: *frame,
+            radius: positive(radius + d)?,
+        },
+        SurfaceDef::Sphere { frame, radius } => SurfaceDef::Sphere {
+            frame: *frame,
+            radius: positive(radius + d)?,
+        },
+        SurfaceDef::Torus {
+            frame,
+            major,
+            minor,
+        } => SurfaceDef::Torus {
+            frame: *frame,
+            major: *major,
+            minor: positive(minor + d)?,
+        },
+        SurfaceDef::Cone {
+            frame,
+            radius,
+            semi_angle,
+        } => SurfaceDef::Cone {
+            frame: *frame,
+            // An apex (radius 0) is a cone still.
+            radius: Some(radius + d / semi_angle.cos()).filter(|r| *r >= 0.0)?,
+            semi_angle: *semi_angle,
+        },
+        _ => return None,
+    })
+}
+
+/// The curve entities whose knots are implied, in [`ImpliedKnots`] order.
+const CURVE_FORMS: [&str; 3] = ["BEZIER_CURVE", "UNIFORM_CURVE", "QUASI_UNIFORM_CURVE"];
+/// The surface entities whose knots are implied, in [`ImpliedKnots`] order.
+const SURFACE_FORMS: [&str; 3] = ["BEZIER_SURFACE", "UNIFORM_SURFACE", "QUASI_UNIFORM_SURFACE"];
+
+/// B-spline forms whose knots are implied rather than listed (ISO 10303-42 §4.3.4:
+/// bezier_curve, uniform_curve, quasi_uniform_curve and their surface counterparts).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum ImpliedKnots {
+    Bezier,
+    Uniform,
+    QuasiUniform,
+}
+
+impl ImpliedKnots {
+    /// The form an instance declares by one of its records (the simple entity's name or a
+    /// partial record of a complex instance), if any; `names` are the entity names of
+    /// the three forms, [`CURVE_FORMS`] or [`SURFACE_FORMS`].
+    fn of(inst: &Instance, names: [&str; 3]) -> Option<ImpliedKnots> {
+        let forms = [
+            ImpliedKnots::Bezier,
+            ImpliedKnots::Uniform,
+            ImpliedKnots::QuasiUniform,
+        ];
+        names
+            .iter()
+            .zip(forms)
+            .find(|(name, _)| inst.record(name).is_some())
+            .map(|(_, k)| k)
     }
-    k.extend(std::iter::repeat_n(pieces as f64, degree + 1));
-    Some(k)
+
+    /// The knots for `count` control points of degree `degree`; `None` when the count
+    /// does not fit the form (a Bézier needs a multiple of the degree plus one).
+    /// - bezier: 0 and the last breakpoint repeated `degree + 1` times, the integers
+    ///   between `degree` times (a piecewise Bézier);
+    /// - uniform: −degree, −degree + 1, …, count (every knot simple), so the domain is
+    ///   [0, count − degree];
+    /// - quasi-uniform: 0 and count − degree repeated `degree + 1` times, the integers
+    ///   between once (clamped ends, uniform inside).
+    fn knots(self, degree: usize, count: usize) -> Option<Vec<f64>> {
+        if degree == 0 || count < degree + 1 {
+            return None;
+        }
+        match self {
+            ImpliedKnots::Bezier => {
+                if !(count - 1).is_multiple_of(degree) {
+                    return None;
+                }
+                let pieces = (count - 1) / degree;
+                let mut k = vec![0.0; degree + 1];
+                for s in 1..pieces {
+                    k.extend(std::iter::repeat_n(s as f64, degree));
+                }
+                k.extend(std::iter::repeat_n(pieces as f64, degree + 1));
+                Some(k)
+            }
+            ImpliedKnots::Uniform => Some(
+                (0..count + degree + 1)
+                    .map(|i| i as f64 - degree as f64)
+                    .collect(),
+            ),
+            ImpliedKnots::QuasiUniform => {
+                let last = (count - degree) as f64;
+                let mut k = vec![0.0; degree + 1];
+                k.extend((1..count - degree).map(|i| i as f64));
+                k.extend(std::iter::repeat_n(last, degree + 1));
+                Some(k)
+            }
+        }
+    }
 }
 
 impl<'e, 'a> Resolver<'e, 'a> {
@@ -536,7 +675,7 @@ impl<'e, 'a> Resolver<'e, 'a> {
         if let Some(r) = self.named(inst, "B_SPLINE_CURVE_WITH_KNOTS") {
             return self.bspline_curve(inst, &r).map(Curve::BSpline);
         }
-        if inst.record("BEZIER_CURVE").is_some() {
+        if ImpliedKnots::of(inst, CURVE_FORMS).is_some() {
             return self
                 .bspline_curve(inst, &self.rec(inst))
                 .map(Curve::BSpline);
@@ -581,7 +720,7 @@ impl<'e, 'a> Resolver<'e, 'a> {
                 }
                 Ok(Curve::OnSurface { curve, pcurves })
             }
-            _ => Err(self.unsupported(&r, "a supported curve (LINE, CIRCLE, ELLIPSE, B_SPLINE_CURVE_WITH_KNOTS, BEZIER_CURVE, TRIMMED_CURVE, SURFACE_CURVE, SEAM_CURVE)")),
+            _ => Err(self.unsupported(&r, "a supported curve (LINE, CIRCLE, ELLIPSE, B_SPLINE_CURVE_WITH_KNOTS, BEZIER_CURVE, UNIFORM_CURVE, QUASI_UNIFORM_CURVE, TRIMMED_CURVE, SURFACE_CURVE, SEAM_CURVE)")),
         }
     }
 
@@ -662,12 +801,19 @@ impl<'e, 'a> Resolver<'e, 'a> {
                 self.coordinates(&p, 1, "coordinates")
             })
             .collect::<Result<Vec<_>, _>>()?;
-        let knots = if inst.record("BEZIER_CURVE").is_some() {
-            bezier_knots(degree, points.len()).ok_or_else(|| {
-                base.error(format!(
-                    "expected a multiple of {degree} plus one control points for a Bézier curve of degree {degree}, found {}",
-                    points.len()
-                ))
+        let knots = if let Some(form) = ImpliedKnots::of(inst, CURVE_FORMS) {
+            form.knots(degree, points.len()).ok_or_else(|| {
+                base.error(match form {
+                    ImpliedKnots::Bezier => format!(
+                        "expected a multiple of {degree} plus one control points for a Bézier curve of degree {degree}, found {}",
+                        points.len()
+                    ),
+                    _ => format!(
+                        "expected at least {} control points for degree {degree}, found {}",
+                        degree + 1,
+                        points.len()
+                    ),
+                })
             })?
         } else {
             let (kr, koff) = match self.named(inst, "B_SPLINE_CURVE_WITH_KNOTS") {
@@ -721,7 +867,7 @@ impl<'e, 'a> Resolver<'e, 'a> {
 
     fn read_surface(&self, inst: &'e Instance<'a>) -> Result<SurfaceDef, ParseError> {
         if inst.record("B_SPLINE_SURFACE_WITH_KNOTS").is_some()
-            || inst.record("BEZIER_SURFACE").is_some()
+            || ImpliedKnots::of(inst, SURFACE_FORMS).is_some()
         {
             return self.bspline_surface(inst).map(SurfaceDef::BSpline);
         }
@@ -783,7 +929,17 @@ impl<'e, 'a> Resolver<'e, 'a> {
                     direction: dir * magnitude,
                 })
             }
-            _ => Err(self.unsupported(&r, "a supported surface (PLANE, CYLINDRICAL_SURFACE, CONICAL_SURFACE, SPHERICAL_SURFACE, TOROIDAL_SURFACE, SURFACE_OF_REVOLUTION, SURFACE_OF_LINEAR_EXTRUSION, B_SPLINE_SURFACE_WITH_KNOTS, BEZIER_SURFACE)")),
+            "OFFSET_SURFACE" => {
+                let basis = self.surface_by_id(&r, r.reference(1, "a basis surface")?)?;
+                let distance = r.real(2, "a distance")?;
+                offset_exactly(&basis, distance).ok_or_else(|| {
+                    self.unsupported(
+                        &r,
+                        "an offset of a plane, cylinder, cone, sphere or torus that keeps it one (other offsets are not read)",
+                    )
+                })
+            }
+            _ => Err(self.unsupported(&r, "a supported surface (PLANE, CYLINDRICAL_SURFACE, CONICAL_SURFACE, SPHERICAL_SURFACE, TOROIDAL_SURFACE, SURFACE_OF_REVOLUTION, SURFACE_OF_LINEAR_EXTRUSION, B_SPLINE_SURFACE_WITH_KNOTS, BEZIER_SURFACE, UNIFORM_SURFACE, QUASI_UNIFORM_SURFACE, OFFSET_SURFACE)")),
         }
     }
 
@@ -835,12 +991,11 @@ impl<'e, 'a> Resolver<'e, 'a> {
             ));
         }
         let count_u = points.len();
-        let (knots_u, knots_v) = if inst.record("BEZIER_SURFACE").is_some() {
-            let ku = bezier_knots(degree_u, count_u);
-            let kv = bezier_knots(degree_v, count_v);
-            match (ku, kv) {
+        let (knots_u, knots_v) = if let Some(form) = ImpliedKnots::of(inst, SURFACE_FORMS) {
+            match (form.knots(degree_u, count_u), form.knots(degree_v, count_v)) {
                 (Some(ku), Some(kv)) => (ku, kv),
-                _ => return Err(base.error("expected a multiple of the degree plus one control points in each direction of a Bézier surface")),
+                _ if form == ImpliedKnots::Bezier => return Err(base.error("expected a multiple of the degree plus one control points in each direction of a Bézier surface")),
+                _ => return Err(base.error("expected more control points than the degree in each direction")),
             }
         } else {
             let (kr, koff) = match self.named(inst, "B_SPLINE_SURFACE_WITH_KNOTS") {
@@ -955,12 +1110,13 @@ impl<'e, 'a> Resolver<'e, 'a> {
             return Ok(e.clone());
         }
         let e = self.expect_type(from, id, &["EDGE_CURVE"], 3)?;
+        let (start, end) = (self.vertex(&e, 1)?, self.vertex(&e, 2)?);
         let edge = Arc::new(Edge {
             id,
-            start: self.vertex(&e, 1)?,
-            end: self.vertex(&e, 2)?,
+            start,
+            end,
             closed: e.reference(1, "a vertex")? == e.reference(2, "a vertex")?,
-            curve: self.curve(&e, 3)?,
+            curve: line_through_vertices(self.curve(&e, 3)?, start, end),
             same_sense: e.boolean(4, "same_sense")?,
         });
         self.edges.borrow_mut().insert(id, edge.clone());
@@ -973,15 +1129,25 @@ mod tests {
     use super::*;
 
     #[test]
-    fn bezier_knots_follow_iso_42() {
+    fn implied_knots_follow_iso_42() {
+        let bezier = |d, n| ImpliedKnots::Bezier.knots(d, n);
+        assert_eq!(bezier(3, 4).unwrap(), [0., 0., 0., 0., 1., 1., 1., 1.]);
+        assert_eq!(bezier(2, 5).unwrap(), [0., 0., 0., 1., 1., 2., 2., 2.]);
+        assert!(bezier(2, 4).is_none());
+        // ISO 10303-42 §4.3.4: uniform knots run from −degree by 1, quasi-uniform ones are
+        // clamped (degree + 1 at each end) with unit steps between.
         assert_eq!(
-            bezier_knots(3, 4).unwrap(),
+            ImpliedKnots::Uniform.knots(2, 4).unwrap(),
+            [-2., -1., 0., 1., 2., 3., 4.]
+        );
+        assert_eq!(
+            ImpliedKnots::QuasiUniform.knots(2, 5).unwrap(),
+            [0., 0., 0., 1., 2., 3., 3., 3.]
+        );
+        assert_eq!(
+            ImpliedKnots::QuasiUniform.knots(3, 4).unwrap(),
             [0., 0., 0., 0., 1., 1., 1., 1.]
         );
-        assert_eq!(
-            bezier_knots(2, 5).unwrap(),
-            [0., 0., 0., 1., 1., 2., 2., 2.]
-        );
-        assert!(bezier_knots(2, 4).is_none());
+        assert!(ImpliedKnots::Uniform.knots(3, 3).is_none());
     }
 }

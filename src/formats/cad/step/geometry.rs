@@ -145,6 +145,17 @@ impl Curve {
         }
     }
 
+    /// The period of a closed B-spline (its two ends the same point, within rounding):
+    /// the length of its domain, over which its points then repeat.
+    pub fn closed_period(&self) -> Option<f64> {
+        let Curve::BSpline(c) = self.space_curve() else {
+            return None;
+        };
+        let (a, b) = crate::geom::nurbs::knots::domain(c.degree, &c.knots);
+        let (p, q) = (c.eval(a), c.eval(b));
+        (p.distance(q) <= 1e-9 * (1.0 + p.abs().max_element())).then_some(b - a)
+    }
+
     /// The 3D curve of a SURFACE_CURVE / SEAM_CURVE, the curve itself otherwise.
     pub fn space_curve(&self) -> &Curve {
         match self {
@@ -192,15 +203,39 @@ impl SurfaceDef {
         }
     }
 
-    /// Periods of (u, v): 2π for the angles of the elementary surfaces of revolution.
+    /// Periods of (u, v): 2π for the angles of the elementary surfaces of revolution, the
+    /// domain's length along a closed profile of an extrusion or revolution.
     pub fn periods(&self) -> [Option<f64>; 2] {
         match self {
-            SurfaceDef::Cylinder { .. }
-            | SurfaceDef::Cone { .. }
-            | SurfaceDef::Sphere { .. }
-            | SurfaceDef::Revolution { .. } => [Some(TAU), None],
+            SurfaceDef::Cylinder { .. } | SurfaceDef::Cone { .. } | SurfaceDef::Sphere { .. } => {
+                [Some(TAU), None]
+            }
+            SurfaceDef::Revolution { profile, .. } => [Some(TAU), profile.closed_period()],
+            SurfaceDef::Extrusion { profile, .. } => [profile.closed_period(), None],
             SurfaceDef::Torus { .. } => [Some(TAU), Some(TAU)],
             _ => [None, None],
+        }
+    }
+
+    /// The interval a parameter is defined over when the surface ends there rather than
+    /// going on (a B-spline's domain, a B-spline profile's); `None` for angles and lines.
+    pub fn fixed_span(&self, axis: usize) -> Option<(f64, f64)> {
+        let profile_span = |c: &Curve| match c.space_curve() {
+            Curve::BSpline(_) => Some(c.domain()),
+            _ => None,
+        };
+        match (self, axis) {
+            (SurfaceDef::BSpline(n), _) => {
+                let d = n.domain();
+                Some(if axis == 0 {
+                    (d.u0, d.u1)
+                } else {
+                    (d.v0, d.v1)
+                })
+            }
+            (SurfaceDef::Extrusion { profile, .. }, 0) => profile_span(profile),
+            (SurfaceDef::Revolution { profile, .. }, 1) => profile_span(profile),
+            _ => None,
         }
     }
 

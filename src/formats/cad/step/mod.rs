@@ -288,6 +288,9 @@ pub fn read_model(path: &Path, src: &str) -> Result<(CadModel, Report), ParseErr
         }
         placed.push(faces);
     }
+    // Tolerances follow the faces' own extent where they have edges: files hold points
+    // far from their faces (CATIA's k1 key: a wireframe kilometres wide).
+    let size = topology::faces_extent(resolved.iter().map(|(_, f)| f)).unwrap_or(size);
     let outcomes: Vec<(u64, Result<topology::FaceOutcome, String>)> = resolved
         .par_iter()
         .map(|(fid, face)| (*fid, topology::convert_face(face, size)))

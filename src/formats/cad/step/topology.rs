@@ -5,7 +5,7 @@
 //!
 //! An edge's piece of a loop is its PCURVE on the face's surface where the file gives one
 //! that agrees with the 3D curve, exact (lines, B-splines, circle and ellipse arcs);
-//! otherwise the 3D edge curve is projected, sample by sample, into the surface's
+//! otherwise the 3D edge curve is projected (`geom::pcurve`), sample by sample, into the surface's
 //! parameters (closed forms for the elementary surfaces, point inversion for B-splines),
 //! refined until the chord between samples lies within [`CHORD_TOLERANCE`] of the projection,
 //! and the largest distance found is reported as the projection error.
@@ -24,8 +24,9 @@ use glam::{DVec2, DVec3, DVec4};
 
 use super::entities::{Curve, Edge, Face, PCurve, SurfaceDef};
 use super::geometry::{curve_to_nurbs, surface_to_nurbs};
-use crate::geom::nurbs::NurbsCurve;
 use crate::geom::nurbs::inversion::Inverter;
+use crate::geom::nurbs::{NurbsCurve, NurbsSurface};
+use crate::geom::pcurve::{self, ParamSurface, unwrap};
 use crate::geom::trim::{ParamCurve, TrimLoop, TrimSegment};
 use crate::scene::model::{Surface, SurfaceGeometry};
 
@@ -36,11 +37,6 @@ pub const CHORD_TOLERANCE: f64 = 1e-5;
 /// How far a pcurve may stray from its 3D curve, relative to the model's size, and still
 /// be used: CAD systems write edges to tolerances of about 1e-7 to 1e-4 of the part.
 const PCURVE_TOLERANCE: f64 = 1e-4;
-/// Segments a projected edge starts with before refinement (enough that a curve bending
-/// back on itself cannot hide between the first samples).
-const MIN_SEGMENTS: usize = 4;
-/// Halvings of a projected segment at most: 4 · 2^10 = 4096 samples per edge.
-const MAX_REFINE: usize = 10;
 
 /// A converted face and what its conversion measured.
 pub struct FaceOutcome {
@@ -119,14 +115,6 @@ impl Piece {
     }
 }
 
-/// `x` moved by whole periods to lie nearest `near`.
-fn unwrap(x: f64, near: f64, period: Option<f64>) -> f64 {
-    match period {
-        Some(p) => x - ((x - near) / p).round() * p,
-        None => x,
-    }
-}
-
 /// The face's surface as far as the loops need it: its definition, its periods, and a
 /// point inverter for B-spline surfaces.
 struct Domain<'f> {
@@ -137,99 +125,52 @@ struct Domain<'f> {
     scale: f64,
 }
 
-impl Domain<'_> {
+impl ParamSurface for Domain<'_> {
     fn point(&self, uv: DVec2) -> DVec3 {
-        self.def.point(uv.x, uv.y)
+        // A closed B-spline (surface or profile) taken as periodic: parameters beyond its
+        // domain wrap into it.
+        let mut w = uv;
+        for axis in 0..2 {
+            if let (Some(p), Some((lo, _))) = (self.periods[axis], self.def.fixed_span(axis)) {
+                w[axis] = lo + (w[axis] - lo).rem_euclid(p);
+            }
+        }
+        self.def.point(w.x, w.y)
     }
 
-    /// Parameters of `p`, unwrapped to lie nearest `near`.
-    fn uv(&self, p: DVec3, near: Option<DVec2>) -> Option<DVec2> {
-        let uv = match self.def.parameters_of(p) {
-            Some(uv) => uv,
+    fn parameters(&self, p: DVec3) -> Option<DVec2> {
+        match self.def.parameters_of(p) {
+            Some(uv) => Some(uv),
             None => {
                 let hit = self.inverter.as_ref()?.project(p)?;
-                DVec2::new(hit.u, hit.v)
+                Some(DVec2::new(hit.u, hit.v))
             }
-        };
-        Some(match near {
-            Some(n) => DVec2::new(
-                unwrap(uv.x, n.x, self.periods[0]),
-                unwrap(uv.y, n.y, self.periods[1]),
-            ),
-            None => uv,
-        })
+        }
+    }
+
+    fn periods(&self) -> [Option<f64>; 2] {
+        self.periods
+    }
+}
+
+impl Domain<'_> {
+    /// Parameters of `p`, unwrapped to lie nearest `near`.
+    fn uv(&self, p: DVec3, near: Option<DVec2>) -> Option<DVec2> {
+        pcurve::parameters_near(self, p, near)
     }
 
     /// Whether the periodic u collapses at `uv` (a sphere's pole, a cone's apex), where the
     /// angle of a point means nothing.
     fn collapsed_u(&self, uv: DVec2) -> bool {
-        self.periods[0].is_some()
-            && self
-                .point(uv)
-                .distance(self.point(uv + DVec2::new(1.0, 0.0)))
-                <= self.scale * CHORD_TOLERANCE
+        pcurve::collapsed(self, uv, 0, self.scale * CHORD_TOLERANCE)
     }
 
-    /// The projection of `c` over `[ta, tb]` into the parameter plane as a polyline refined
-    /// until every chord's midpoint maps within tolerance of the projected curve, and the
-    /// largest distance met between the edge and the surface or the chords and the
-    /// projection.
+    /// The projection of `c` over `[ta, tb]` into the parameter plane (`geom::pcurve`),
+    /// its chords within [`CHORD_TOLERANCE`] of the model.
     fn project(&self, c: &Curve, ta: f64, tb: f64) -> Result<(Vec<DVec2>, f64), String> {
-        let tol = self.scale * CHORD_TOLERANCE;
-        let mut worst: f64 = 0.0;
-        let mut measure = |t: f64, near: Option<DVec2>| -> Result<DVec2, String> {
-            let p = c.point(t);
-            let uv = self
-                .uv(p, near)
-                .ok_or_else(|| format!("cannot project the edge point {p} onto the surface"))?;
-            worst = worst.max(self.point(uv).distance(p));
-            Ok(uv)
-        };
-        let mut ts = Vec::new();
-        let mut uvs: Vec<DVec2> = Vec::new();
-        for k in 0..=MIN_SEGMENTS {
-            let t = ta + (tb - ta) * k as f64 / MIN_SEGMENTS as f64;
-            let uv = measure(t, uvs.last().copied())?;
-            ts.push(t);
-            uvs.push(uv);
-        }
-        // Refine: a stack of segments, left to right.
-        let mut out = vec![uvs[0]];
-        let mut stack: Vec<(f64, DVec2, f64, DVec2, usize)> = (0..MIN_SEGMENTS)
-            .rev()
-            .map(|k| (ts[k], uvs[k], ts[k + 1], uvs[k + 1], 0))
-            .collect();
-        let mut chord_worst: f64 = 0.0;
-        while let Some((t0, a, t1, b, depth)) = stack.pop() {
-            let tm = 0.5 * (t0 + t1);
-            let m = measure(tm, Some(a))?;
-            // The chord's error against the projected curve (the edge's own distance
-            // from the surface is the projection error, measured in `measure`).
-            let err = self.point(0.5 * (a + b)).distance(self.point(m));
-            if err > tol && depth < MAX_REFINE {
-                stack.push((tm, m, t1, b, depth + 1));
-                stack.push((t0, a, tm, m, depth + 1));
-            } else {
-                chord_worst = chord_worst.max(err);
-                out.push(b);
-            }
-        }
-        // Points at a pole take the angle of their neighbour along the edge.
-        for k in 0..out.len() {
-            if self.collapsed_u(out[k]) {
-                let neighbour = if k + 1 < out.len() && !self.collapsed_u(out[k + 1]) {
-                    Some(out[k + 1].x)
-                } else if k > 0 {
-                    Some(out[k - 1].x)
-                } else {
-                    None
-                };
-                if let Some(u) = neighbour {
-                    out[k].x = u;
-                }
-            }
-        }
-        Ok((out, worst.max(chord_worst)))
+        pcurve::project(self, |t| c.point(t), ta, tb, self.scale * CHORD_TOLERANCE)
+            .map(|p| (p.points, p.error))
+            .map_err(|p| format!("cannot project the edge point {p} onto the surface"))
     }
 
     /// The pcurve `pc` over `[ta, tb]`, exact, if it agrees with the 3D curve there (its
@@ -269,7 +210,9 @@ impl Domain<'_> {
 
     fn pcurve_piece(&self, pc: &PCurve, c3: &Curve, ta: f64, tb: f64) -> Option<TrimSegment> {
         let tol = self.scale * PCURVE_TOLERANCE;
-        let agrees = [ta, 0.5 * (ta + tb), tb].iter().all(|&t| {
+        // Checked at nine points: a wrong pcurve can agree with its edge at the ends
+        // and the middle (one that bulges the other way between them).
+        let agrees = (0..=8).map(|k| ta + (tb - ta) * k as f64 / 8.0).all(|t| {
             self.point(pc.curve.point(t).truncate())
                 .distance(c3.point(t))
                 <= tol
@@ -326,16 +269,143 @@ fn edge_interval(e: &Edge) -> (f64, f64) {
     }
 }
 
+/// The periods of a B-spline surface closed in u or v (its two boundary curves across
+/// that direction the same within `tol`, checked at 17 points): the length of its domain
+/// there, so that a trim crossing the seam is unwrapped as on an elementary surface.
+fn closed_periods(n: &NurbsSurface, tol: f64) -> [Option<f64>; 2] {
+    let d = n.domain();
+    let closed = |a: &dyn Fn(f64) -> DVec3, b: &dyn Fn(f64) -> DVec3| {
+        (0..=16).all(|k| a(k as f64 / 16.0).distance(b(k as f64 / 16.0)) <= tol)
+    };
+    let at_v = |s: f64| d.v0 + (d.v1 - d.v0) * s;
+    let at_u = |s: f64| d.u0 + (d.u1 - d.u0) * s;
+    let closed_u = closed(&|s| n.eval(d.u0, at_v(s)), &|s| n.eval(d.u1, at_v(s)));
+    let closed_v = closed(&|s| n.eval(at_u(s), d.v0), &|s| n.eval(at_u(s), d.v1));
+    [
+        closed_u.then_some(d.u1 - d.u0),
+        closed_v.then_some(d.v1 - d.v0),
+    ]
+}
+
+/// Twice the signed area a loop encloses in the parameter plane as traversed (positive
+/// counter-clockwise), from its pieces' samples.
+fn signed_area(pieces: &[Piece]) -> f64 {
+    let mut points: Vec<DVec2> = Vec::new();
+    for p in pieces {
+        let start = points.len();
+        points.extend(p.samples());
+        if p.reversed {
+            points[start..].reverse();
+        }
+    }
+    (0..points.len())
+        .map(|k| points[k].perp_dot(points[(k + 1) % points.len()]))
+        .sum()
+}
+
+/// The whole range of v of a surface closed in it (from pole to pole of a sphere, over a
+/// revolution's profile, a turn of a torus's tube from `v0`, a B-spline's domain).
+fn natural_v(def: &SurfaceDef, v0: f64) -> Option<(f64, f64)> {
+    use std::f64::consts::{FRAC_PI_2, TAU};
+    match def {
+        SurfaceDef::Sphere { .. } => Some((-FRAC_PI_2, FRAC_PI_2)),
+        SurfaceDef::Torus { .. } => Some((v0, v0 + TAU)),
+        SurfaceDef::Revolution { profile, .. } => {
+            let (a, b) = profile.domain();
+            (a.is_finite() && b.is_finite()).then_some((a, b))
+        }
+        SurfaceDef::BSpline(n) => {
+            let d = n.domain();
+            Some((d.v0, d.v1))
+        }
+        _ => None,
+    }
+}
+
+/// Where a sphere's or cone's v meets its axis beyond `v`, upwards (`high`) or
+/// downwards: a pole (v = ±π/2) or the apex (v = −r / tan α); `None` on that side of
+/// every other surface, which goes on without end there.
+fn pole_towards(def: &SurfaceDef, v: f64, high: bool) -> Option<f64> {
+    let pole = match def {
+        SurfaceDef::Sphere { .. } => {
+            if high {
+                std::f64::consts::FRAC_PI_2
+            } else {
+                -std::f64::consts::FRAC_PI_2
+            }
+        }
+        SurfaceDef::Cone {
+            radius, semi_angle, ..
+        } if *semi_angle != 0.0 => -radius / semi_angle.tan(),
+        _ => return None,
+    };
+    (if high { pole > v } else { pole < v }).then_some(pole)
+}
+
+/// A face without edge bounds: the whole of a closed surface (ISO 10303-42 §5.4.x: a
+/// face's bounds may be empty when its surface is closed; OpenCASCADE takes the natural
+/// bounds): a sphere, a torus, a B-spline surface over its domain.
+fn whole_face(face: &Face) -> Result<FaceOutcome, String> {
+    use std::f64::consts::{FRAC_PI_2, TAU};
+    let (u, v) = match &*face.surface {
+        SurfaceDef::Sphere { .. } => ([0.0, TAU], [-FRAC_PI_2, FRAC_PI_2]),
+        SurfaceDef::Torus { .. } => ([0.0, TAU], [0.0, TAU]),
+        SurfaceDef::BSpline(n) => {
+            let d = n.domain();
+            ([d.u0, d.u1], [d.v0, d.v1])
+        }
+        _ => {
+            return Err(
+                "it has no edge bounds and its surface is unbounded (only a sphere, torus or B-spline surface can be a whole face)".into(),
+            );
+        }
+    };
+    let (nurbs, trim_space) = surface_to_nurbs(&face.surface, u, v).map_err(|e| e.to_string())?;
+    let mut surface = Surface {
+        geometry: SurfaceGeometry::Nurbs(nurbs),
+        trims: Vec::new(),
+        trim_space,
+    };
+    if !face.same_sense {
+        surface.flip_sides();
+    }
+    Ok(FaceOutcome {
+        surface,
+        projection_error: 0.0,
+        projected_edges: 0,
+    })
+}
+
+/// The diagonal of the box of the faces' vertices (edge ends and vertex loops): the
+/// model's size as its B-rep spans it; `None` for faces without vertices.
+pub fn faces_extent<'f>(faces: impl Iterator<Item = &'f Face>) -> Option<f64> {
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for b in faces.flat_map(|f| &f.bounds) {
+        let ends = b.edges.iter().flat_map(|oe| [oe.edge.start, oe.edge.end]);
+        for p in ends.chain(b.vertex).filter(|p| p.is_finite()) {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+    }
+    (lo.x <= hi.x).then(|| lo.distance(hi).max(f64::MIN_POSITIVE))
+}
+
 /// Converts one face; the error says why it could not be (the caller names the face).
+/// `scale` is the model's size, which the tolerances are relative to.
 pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
     let def = &*face.surface;
     let inverter = match def {
         SurfaceDef::BSpline(n) => Some(Inverter::new(n)),
         _ => None,
     };
+    let periods = match def {
+        SurfaceDef::BSpline(n) => closed_periods(n, scale * CHORD_TOLERANCE),
+        _ => def.periods(),
+    };
     let dom = Domain {
         def,
-        periods: def.periods(),
+        periods,
         inverter,
         scale,
     };
@@ -343,7 +413,13 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
     let mut projected_edges = 0;
     // Each edge's candidate pieces, once per face (a seam edge appears twice in a loop).
     let mut candidates: HashMap<u64, Vec<TrimSegment>> = HashMap::new();
-    let mut loops: Vec<(Vec<Piece>, Option<usize>)> = Vec::new();
+    if face.bounds.iter().all(|b| b.edges.is_empty()) {
+        return whole_face(face);
+    }
+    // Each loop's pieces, the periodic axis it winds around (if it does), whether it
+    // runs towards increasing parameter along that axis as a bound of the face, and
+    // whether the face lies to the left of its pieces as traversed.
+    let mut loops: Vec<(Vec<Piece>, Option<usize>, bool, bool)> = Vec::new();
     let mut extent_points: Vec<DVec2> = Vec::new();
     let mut outer_u: Option<(f64, f64)> = None;
     let outer_index = face.bounds.iter().position(|b| b.outer).unwrap_or(0);
@@ -437,6 +513,28 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
             }
             pieces.push(piece);
         }
+        // On a closed B-spline (surface or profile) the outer loop is placed by whole
+        // periods over its domain (the seam's points invert to either end).
+        if outer_u.is_none() {
+            let mut lo = DVec2::splat(f64::INFINITY);
+            let mut hi = DVec2::splat(f64::NEG_INFINITY);
+            for q in pieces.iter().flat_map(Piece::samples) {
+                lo = lo.min(q);
+                hi = hi.max(q);
+            }
+            let mut shift = DVec2::ZERO;
+            for axis in 0..2 {
+                if let (Some(p), Some((a, b))) = (dom.periods[axis], def.fixed_span(axis)) {
+                    let centre = 0.5 * (a + b);
+                    shift[axis] = ((centre - 0.5 * (lo[axis] + hi[axis])) / p).round() * p;
+                }
+            }
+            if shift != DVec2::ZERO {
+                for p in &mut pieces {
+                    p.shift(shift);
+                }
+            }
+        }
         // Holes first placed within the outer loop's periodic range.
         if let (Some((u0, _)), Some(period)) = (outer_u, dom.periods[0]) {
             let s = pieces[0].start().x;
@@ -468,7 +566,12 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
         if outer_u.is_none() {
             outer_u = Some((lo, hi));
         }
-        loops.push((pieces, winds));
+        // ISO 10303-42 §5.4.x: a FALSE face_bound orientation reverses every oriented
+        // edge of its loop, and a face whose same_sense is FALSE has its normal against
+        // the surface's, so its loops' left side is the surface's right.
+        let left = bound.orientation == face.same_sense;
+        let forwards = winds.is_some_and(|axis| gap[axis] < 0.0) == left;
+        loops.push((pieces, winds, forwards, left));
     }
     // The surface over the loops' extent (B-splines keep their own domain).
     let mut lo = DVec2::splat(f64::INFINITY);
@@ -484,10 +587,6 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
         };
         lo = DVec2::new(d.u0, d.v0);
         hi = DVec2::new(d.u1, d.v1);
-    } else if !(lo.x < hi.x && lo.y < hi.y) {
-        return Err(
-            "its bounds enclose no area of the surface (an unbounded or degenerate face)".into(),
-        );
     }
     for axis in 0..2 {
         if let Some(p) = dom.periods[axis] {
@@ -498,14 +597,77 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
         lo.y = lo.y.max(-std::f64::consts::FRAC_PI_2);
         hi.y = hi.y.min(std::f64::consts::FRAC_PI_2);
     }
+    // Bounds that are all holes (each loop has the face on its right, ISO 10303-42
+    // face_bound, and none is the outer bound): the face is its closed surface with those
+    // holes cut out (a ball drilled through), so it spans the surface's natural range.
+    let all_holes = !face.bounds.iter().any(|b| b.outer && !b.edges.is_empty())
+        && loops
+            .iter()
+            .all(|l| l.1.is_none() && (signed_area(&l.0) > 0.0) != l.3);
+    // Only a surface closed around u (or a B-spline closed either way) can be such a
+    // face; elsewhere the loops are taken as they come, as before.
+    let natural = match (all_holes, dom.periods[0], def) {
+        (false, ..) => None,
+        (true, Some(p), _) => natural_v(def, lo.y).map(|v| ([lo.x, lo.x + p], v)),
+        (true, None, SurfaceDef::BSpline(_)) if dom.periods[1].is_some() => {
+            natural_v(def, lo.y).map(|v| ([lo.x, hi.x], v))
+        }
+        _ => None,
+    };
+    if let Some(([u0, u1], (v0, v1))) = natural {
+        lo = DVec2::new(u0, v0);
+        hi = DVec2::new(u1, v1);
+    }
+    let all_holes = natural.is_some();
+    // Loops winding around u an odd number of times leave one side of the face open,
+    // where every winding loop is closed beyond the range so that even–odd parity keeps
+    // the face. Alone, the first such loop gives that side by its orientation (a face
+    // lies to the left of its bounds, ISO 10303-42 face_bound) and the face reaches the
+    // pole or apex there; otherwise the other bounds' extent gives it.
+    let mut close_high = true;
+    let mut around_u = loops.iter().filter(|l| l.1 == Some(0));
+    if around_u.clone().count() % 2 == 1
+        && let Some(first) = around_u.next()
+    {
+        let v = first.0[0].start().y;
+        // No extent in v beyond the loop's own rounding: nothing else bounds that side.
+        let slack = 1e-9 * (1.0 + lo.y.abs().max(hi.y.abs()));
+        if (hi.y - lo.y).partial_cmp(&slack) != Some(std::cmp::Ordering::Greater) {
+            close_high = first.2;
+            let pole = pole_towards(def, v, close_high).ok_or_else(|| {
+                "its single loop around the surface leaves the face unbounded on one side"
+                    .to_string()
+            })?;
+            if close_high {
+                hi.y = pole;
+            } else {
+                lo.y = pole;
+            }
+        } else {
+            // Other bounds (a vertex loop at the apex, a seam run to the pole) give the
+            // open side, whatever the loop's orientation says (OpenCASCADE's healing
+            // turns such a loop around too).
+            close_high = (v - lo.y).abs() <= (hi.y - v).abs();
+        }
+    }
+    if !(lo.x < hi.x && lo.y < hi.y) {
+        return Err(
+            "its bounds enclose no area of the surface (an unbounded or degenerate face)".into(),
+        );
+    }
     let (nurbs, trim_space) =
         surface_to_nurbs(def, [lo.x, hi.x], [lo.y, hi.y]).map_err(|e| e.to_string())?;
     // Winding loops close beyond the other parameter's range, all on the same side.
     let mut trims = Vec::new();
-    for (k, (mut pieces, winds)) in loops.into_iter().enumerate() {
+    for (k, (mut pieces, winds, _, _)) in loops.into_iter().enumerate() {
         if let Some(axis) = winds {
             let other = 1 - axis;
-            let far = hi[other] + (hi[other] - lo[other]).max(1.0);
+            let margin = (hi[other] - lo[other]).max(1.0);
+            let far = if close_high || axis == 1 {
+                hi[other] + margin
+            } else {
+                lo[other] - margin
+            };
             let (first, last) = (pieces[0].start(), pieces[pieces.len() - 1].end());
             let mut a = last;
             a[other] = far;
@@ -517,7 +679,8 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
             ));
         }
         trims.push(TrimLoop {
-            hole: k > 0,
+            // Holes only: the surface's domain is the outer bound (`geom::trim`).
+            hole: all_holes || k > 0,
             // A segment runs from t0 to t1 in either order (`geom::trim`): reversed
             // pieces swap them, so each segment starts where the previous one ended.
             segments: pieces

@@ -12,7 +12,8 @@
 //! | 8 | 8 | record count `u64` (the tree's primitive count when there are records) |
 //! | 16 | 8 | trim loops in the scene `u64` (for the effect line; none cuts a mapped patch) |
 //! | 24 | 8 | record size `u64` ([`PatchRecord`], 680) |
-//! | 32 | 680 × records | [`PatchRecord`]s, in primitive order |
+//! | 32 | 24 | floating origin, three `f64` ([`crate::scene::origin`]) |
+//! | 56 | 680 × records | [`PatchRecord`]s, in primitive order |
 //! | … | 8 | [`checksum`] of the section before it |
 //!
 //! Then the scene section, the scene file's parse for `render --bvh` to skip the RON parse
@@ -20,6 +21,9 @@
 //! geometry file the key of its inputs), the length `u64` of the JSON that follows
 //! (`ron_format::SceneFile`, or for a bare geometry file its scene without geometry,
 //! `scene::bare_shell::BareShell`), the JSON, and the [`checksum`] of the section.
+//!
+//! The tree and the records are built in the scene moved by minus the floating origin
+//! (format version 4); the scene section keeps the scene where it was.
 //!
 //! Records hold what the render reads of a patch: the `f32` net of the bicubic or bilinear
 //! fast path, its box, its (object, patch) number, and the `f64` control points and domain
@@ -33,20 +37,21 @@ use std::fs::File;
 use std::io::{self, Write};
 use std::path::Path;
 
-use glam::{DVec3, DVec4, Vec3, Vec4};
+use glam::DVec3;
 use memmap2::Mmap;
 use rayon::prelude::*;
 
-use super::bvh::{Bvh, BvhFileError, checksum};
-use super::patches::OwnedPatches;
+use crate::accel::bvh::{Bvh, BvhFileError, checksum};
 use crate::formats::LoadError;
-use crate::geom::bezier::ParamRect;
 use crate::geom::subdiv::Piece;
 use crate::geom::{Aabb, BezierPatch};
 use crate::kernel::subdivision::PreparedPatch;
-use crate::kernel::subdivision::bicubic::Net;
-use crate::kernel::subdivision::bilinear::BilinearNet;
-use crate::kernel::subdivision::prepared::Prepared;
+use record::PatchRecord;
+
+mod record;
+
+pub use record::RECORD_BYTES;
+pub(super) use record::records;
 
 /// The key a scene's BVH file records: its inputs' key (`scene::source_key`) with what else
 /// decides the prepared patches: `--ignore-trims`, and whether this host prepares bilinear
@@ -62,222 +67,17 @@ pub fn key(source: u64, ignore_trims: bool) -> u64 {
     xxhash_rust::xxh3::xxh3_64(&bytes)
 }
 
-/// Most control points a record holds: a bicubic patch's.
-const POINTS: usize = 16;
-
-/// `kind` of a bicubic net whose registers hold rows (fixed v).
-const KIND_ROWS: u32 = 0;
-/// `kind` of a bicubic net whose registers hold columns (fixed u).
-const KIND_COLUMNS: u32 = 1;
-/// `kind` of a bilinear net.
-const KIND_BILINEAR: u32 = 2;
-
-const SECTION_HEADER: usize = 32;
-
-/// `piece_face` of a patch that is not part of a subdivision surface.
-const NO_PIECE: u32 = u32::MAX;
-
-/// Bytes per patch record in the file.
-pub const RECORD_BYTES: usize = size_of::<PatchRecord>();
-
-/// One patch as the file stores it; `Pod`, so that the mapped bytes are records.
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-#[repr(C)]
-pub(super) struct PatchRecord {
-    /// The kernel's net: a bicubic [`Net`]'s three blocks of four registers of four lanes,
-    /// or a [`BilinearNet`]'s three registers in the first twelve.
-    net: [f32; 48],
-    /// [`PreparedPatch::bounds`]: min xyz, max xyz.
-    bounds: [f32; 6],
-    kind: u32,
-    object: u32,
-    patch: u32,
-    /// Degree in u in the low 16 bits, in v in the high 16.
-    degrees: u32,
-    /// For a patch of a subdivision surface its [`Piece`]: the quad, the quarter turns,
-    /// and (in `piece`) the origin u, v and size; `piece_face` is [`NO_PIECE`] otherwise.
-    piece_face: u32,
-    piece_rot: u32,
-    /// The patch's parameter rectangle: u0, u1, v0, v1.
-    domain: [f64; 4],
-    /// Control points x y z, u fastest, the first (du + 1)(dv + 1) used (weights are 1).
-    points: [f64; 3 * POINTS],
-    piece: [f64; 3],
-}
-
-impl PatchRecord {
-    /// The record of an untrimmed patch, `None` for one of the general path or rational.
-    fn new(
-        prepared: &PreparedPatch,
-        original: &BezierPatch,
-        (object, patch): (u32, u32),
-        piece: Option<Piece>,
-    ) -> Option<PatchRecord> {
-        if original.is_rational() || original.point_count() > POINTS {
-            return None;
-        }
-        let mut net = [0.0; 48];
-        let kind = match &prepared.data {
-            Prepared::Bicubic(n) => {
-                let lanes = n.xyz.iter().flatten().flat_map(|r| r.to_array());
-                net.iter_mut().zip(lanes).for_each(|(d, s)| *d = s);
-                if n.transposed {
-                    KIND_COLUMNS
-                } else {
-                    KIND_ROWS
-                }
-            }
-            Prepared::Bilinear(n) => {
-                let lanes = n.xyz.iter().flat_map(|r| r.to_array());
-                net.iter_mut().zip(lanes).for_each(|(d, s)| *d = s);
-                KIND_BILINEAR
-            }
-            Prepared::General { .. } => return None,
-        };
-        let b = prepared.bounds();
-        let d = original.domain();
-        let mut points = [0.0; 3 * POINTS];
-        let coords = original.euclidean_points().flat_map(|p| p.to_array());
-        points.iter_mut().zip(coords).for_each(|(d, s)| *d = s);
-        Some(PatchRecord {
-            net,
-            bounds: [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z],
-            kind,
-            object,
-            patch,
-            degrees: original.degree_u() as u32 | (original.degree_v() as u32) << 16,
-            piece_face: piece.map_or(NO_PIECE, |p| p.face),
-            piece_rot: piece.map_or(0, |p| u32::from(p.rot)),
-            domain: [d.u0, d.u1, d.v0, d.v1],
-            points,
-            piece: piece.map_or([0.0; 3], |p| [p.origin.0, p.origin.1, p.size]),
-        })
-    }
-
-    fn piece(&self) -> Option<Piece> {
-        (self.piece_face != NO_PIECE).then(|| Piece {
-            face: self.piece_face,
-            rot: self.piece_rot as u8,
-            origin: (self.piece[0], self.piece[1]),
-            size: self.piece[2],
-        })
-    }
-
-    fn degrees(&self) -> (usize, usize) {
-        (
-            (self.degrees & 0xffff) as usize,
-            (self.degrees >> 16) as usize,
-        )
-    }
-
-    fn bounds(&self) -> Aabb {
-        let b = &self.bounds;
-        Aabb {
-            min: Vec3::new(b[0], b[1], b[2]),
-            max: Vec3::new(b[3], b[4], b[5]),
-        }
-    }
-
-    fn prepared(&self) -> PreparedPatch {
-        let reg = |at: usize| Vec4::from_slice(&self.net[at..at + 4]);
-        let data = match self.kind {
-            KIND_BILINEAR => Prepared::Bilinear(BilinearNet {
-                xyz: [reg(0), reg(4), reg(8)],
-            }),
-            kind => Prepared::Bicubic(Net {
-                xyz: [0, 16, 32].map(|c| [0, 4, 8, 12].map(|r| reg(c + r))),
-                transposed: kind == KIND_COLUMNS,
-            }),
-        };
-        PreparedPatch {
-            data,
-            bounds: self.bounds(),
-        }
-    }
-
-    /// The `f64` patch. Records are validated when the file is opened (degrees, point count);
-    /// points that are not finite (only in a file forged past its checksum) give the unit
-    /// square, so that no input can make this fail.
-    fn original(&self) -> BezierPatch {
-        let (du, dv) = self.degrees();
-        let n = (du + 1) * (dv + 1);
-        let points: Vec<DVec3> = self.points[..3 * n]
-            .chunks_exact(3)
-            .map(DVec3::from_slice)
-            .collect();
-        let [u0, u1, v0, v1] = self.domain;
-        BezierPatch::from_points(du, dv, &points)
-            .map(|p| p.with_domain(ParamRect { u0, u1, v0, v1 }))
-            .unwrap_or_else(|_| unit_square())
-    }
-
-    /// Why this record cannot be used with a scene of `objects` objects, if it cannot.
-    fn fault(&self, objects: usize) -> Option<String> {
-        let (du, dv) = self.degrees();
-        if !(1..=3).contains(&du) || !(1..=3).contains(&dv) {
-            return Some(format!("degrees {du} × {dv} outside 1..=3"));
-        }
-        if self.kind > KIND_BILINEAR {
-            return Some(format!("unknown net kind {}", self.kind));
-        }
-        if self.piece_face != NO_PIECE
-            && (self.piece_rot > 3
-                || !self.piece.iter().all(|x| x.is_finite())
-                || self.piece[2] <= 0.0)
-        {
-            return Some(format!(
-                "subdivision piece with {} quarter turns and origin and size {:?}",
-                self.piece_rot, self.piece
-            ));
-        }
-        if self.object as usize >= objects {
-            return Some(format!(
-                "object {} in a scene of {objects} objects",
-                self.object
-            ));
-        }
-        None
-    }
-}
-
-fn unit_square() -> BezierPatch {
-    let corners = [
-        DVec4::new(0.0, 0.0, 0.0, 1.0),
-        DVec4::X + DVec4::W,
-        DVec4::Y + DVec4::W,
-        DVec4::ONE.with_z(0.0),
-    ];
-    BezierPatch::new(1, 1, corners.to_vec()).expect("a valid unit square")
-}
-
-/// The patch records of `patches`, or `None` when any patch cannot be mapped (trimmed,
-/// general path, rational); `piece_of(object, patch)` is where a subdivision surface's
-/// patch lies in its quad.
-pub(super) fn records(
-    patches: &OwnedPatches,
-    piece_of: &(dyn Fn(u32, u32) -> Option<Piece> + Sync),
-) -> Option<Vec<PatchRecord>> {
-    if patches.trims.iter().any(Option::is_some) {
-        return None;
-    }
-    (0..patches.prepared.len())
-        .into_par_iter()
-        .map(|i| {
-            let id @ (object, patch) = patches.ids[i];
-            let piece = piece_of(object, patch);
-            PatchRecord::new(&patches.prepared[i], &patches.originals[i], id, piece)
-        })
-        .collect()
-}
+const SECTION_HEADER: usize = 56;
 
 /// Writes the file: `bvh`'s tree section with `key`, then the patch section with `records`
-/// (or none) and the scene's `trim_loops`, then the scene section with `parsed` (the
-/// scene's text hash and its parse as JSON, or nothing).
+/// (or none), the scene's `trim_loops` and the floating `origin` it was built at, then the
+/// scene section with `parsed` (the scene's text hash and its parse as JSON, or nothing).
 pub(super) fn write(
     w: &mut dyn Write,
     bvh: &Bvh,
     key: u64,
     (records, trim_loops): (Option<&[PatchRecord]>, usize),
+    origin: DVec3,
     parsed: Option<(u64, &[u8])>,
 ) -> io::Result<()> {
     let tree = bvh.section(key);
@@ -292,6 +92,9 @@ pub(super) fn write(
         records.len() as u64,
         trim_loops as u64,
         size_of::<PatchRecord>() as u64,
+        origin.x.to_bits(),
+        origin.y.to_bits(),
+        origin.z.to_bits(),
     ] {
         section.extend_from_slice(&field.to_le_bytes());
     }
@@ -357,6 +160,8 @@ pub struct BvhFile {
     pub bvh: Bvh,
     pub patches: Option<MappedPatches>,
     pub trim_loops: usize,
+    /// The floating origin the geometry was moved by (minus it) before it was built.
+    pub origin: DVec3,
 }
 
 /// A mapped BVH file whose every section passed its structural and checksum checks, not
@@ -368,6 +173,7 @@ pub struct Opened {
     /// First record and record count, when the file has records.
     records: Option<(usize, usize)>,
     trim_loops: usize,
+    origin: DVec3,
     /// The scene's parse: the hash of its text and the range of its JSON.
     scene: (u64, std::ops::Range<usize>),
 }
@@ -402,6 +208,10 @@ pub fn map(path: &Path) -> Result<Opened, LoadError> {
         (word(at), word(at + 8), word(at + 16), word(at + 24));
     if has_records > 1 {
         return Err(corrupt(at, format!("patch section flag {has_records}")));
+    }
+    let origin = DVec3::from_array([32, 40, 48].map(|k| f64::from_bits(word(at + k))));
+    if !origin.is_finite() {
+        return Err(corrupt(at + 32, format!("floating origin {origin}")));
     }
     if record_size != RECORD_BYTES as u64 {
         return Err(corrupt(
@@ -472,6 +282,7 @@ pub fn map(path: &Path) -> Result<Opened, LoadError> {
         key,
         records,
         trim_loops: usize::try_from(trim_loops).unwrap_or(usize::MAX),
+        origin,
     })
 }
 
@@ -500,6 +311,7 @@ impl Opened {
                 bvh: self.bvh,
                 patches: None,
                 trim_loops: self.trim_loops,
+                origin: self.origin,
             });
         };
         let patches = MappedPatches {
@@ -522,6 +334,7 @@ impl Opened {
             bvh: self.bvh,
             patches: Some(patches),
             trim_loops: self.trim_loops,
+            origin: self.origin,
         })
     }
 }

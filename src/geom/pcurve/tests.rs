@@ -1,0 +1,108 @@
+use std::f64::consts::TAU;
+
+use super::*;
+use crate::geom::nurbs::shapes;
+
+/// A cylinder of radius `r` about z in closed form: `(r cos u, r sin u, v)`, u 2π-periodic.
+struct Cylinder {
+    r: f64,
+}
+
+impl ParamSurface for Cylinder {
+    fn point(&self, uv: DVec2) -> DVec3 {
+        DVec3::new(self.r * uv.x.cos(), self.r * uv.x.sin(), uv.y)
+    }
+
+    fn parameters(&self, p: DVec3) -> Option<DVec2> {
+        Some(DVec2::new(p.y.atan2(p.x), p.z))
+    }
+
+    fn periods(&self) -> [Option<f64>; 2] {
+        [Some(TAU), None]
+    }
+}
+
+#[test]
+fn a_helix_crossing_the_seam_stays_continuous() {
+    // The helix (r cos t, r sin t, c t) is u = t, v = c t on the cylinder: it crosses the
+    // seam (u = ±π) three times, and must come out as one increasing line, not jumps.
+    let (r, c) = (2.0, 0.3);
+    let s = Cylinder { r };
+    let helix = |t: f64| DVec3::new(r * t.cos(), r * t.sin(), c * t);
+    let p = project(&s, helix, 0.5, 0.5 + 3.0 * TAU, 1e-9).unwrap();
+    assert!(p.error < 1e-12, "{}", p.error);
+    assert!((p.points[0] - DVec2::new(0.5, 0.5 * c)).length() < 1e-12);
+    for w in p.points.windows(2) {
+        assert!(
+            w[1].x > w[0].x,
+            "u runs on across the seam: {} {}",
+            w[0],
+            w[1]
+        );
+        // Every vertex on the line v = c u (closed form).
+        assert!((w[1].y - c * w[1].x).abs() < 1e-12, "{}", w[1]);
+    }
+    let end = *p.points.last().unwrap();
+    assert!((end.x - (0.5 + 3.0 * TAU)).abs() < 1e-12, "{end}");
+}
+
+#[test]
+fn a_circle_of_latitude_on_a_nurbs_sphere_lands_on_it() {
+    // A circle at height h on the unit-radius sphere: its projection's chords, mapped back
+    // onto the NURBS, must stay within the tolerance of that circle (closed form: z = h,
+    // distance √(r² − h²) from the axis).
+    let (r, h) = (1.5, 0.6);
+    let sphere = shapes::sphere(r).unwrap();
+    let target = NurbsTarget::new(&sphere);
+    let rho = (r * r - h * h).sqrt();
+    let circle = |t: f64| DVec3::new(rho * t.cos(), rho * t.sin(), h);
+    let tol = 1e-6;
+    let p = project(&target, circle, 0.2, 0.2 + 1.5, tol).unwrap();
+    assert!(p.error <= tol, "{}", p.error);
+    assert!(p.points.len() > 5, "refined: {} points", p.points.len());
+    for w in p.points.windows(2) {
+        for k in 0..=4 {
+            let uv = w[0].lerp(w[1], k as f64 / 4.0);
+            let q = sphere.eval(uv.x, uv.y);
+            let off = (q.z - h).hypot(q.truncate().length() - rho);
+            assert!(off <= 2.0 * tol, "{q} is {off} off the circle");
+        }
+    }
+}
+
+/// The unit sphere in closed form: `(cos v cos u, cos v sin u, sin v)`, u 2π-periodic,
+/// the poles at v = ±π/2.
+struct Sphere;
+
+impl ParamSurface for Sphere {
+    fn point(&self, uv: DVec2) -> DVec3 {
+        DVec3::new(uv.y.cos() * uv.x.cos(), uv.y.cos() * uv.x.sin(), uv.y.sin())
+    }
+
+    fn parameters(&self, p: DVec3) -> Option<DVec2> {
+        Some(DVec2::new(p.y.atan2(p.x), p.z.atan2(p.x.hypot(p.y))))
+    }
+
+    fn periods(&self) -> [Option<f64>; 2] {
+        [Some(TAU), None]
+    }
+}
+
+#[test]
+fn a_meridian_from_the_pole_keeps_its_longitude() {
+    // The meridian u = 1 from the north pole to the equator: at the pole any u is the
+    // same point, and the projection must take the meridian's (closed form: u = 1,
+    // v = π/2 − t), not whatever atan2(0, 0) gives, or its first chord would cut across.
+    let u = 1.0_f64;
+    let meridian = |t: f64| Sphere.point(DVec2::new(u, std::f64::consts::FRAC_PI_2 - t));
+    let p = project(&Sphere, meridian, 0.0, 1.5, 1e-9).unwrap();
+    assert!(p.error < 1e-12, "{}", p.error);
+    for q in &p.points {
+        assert!((q.x - u).abs() < 1e-12, "{q}");
+    }
+    assert!(
+        p.points.len() < 100,
+        "no refinement at the pole: {}",
+        p.points.len()
+    );
+}
