@@ -57,9 +57,15 @@ fn de(k: usize) -> f64 {
     (2 * k + 1) as f64
 }
 
+/// The Global section of the test files: millimetres.
+const GLOBAL: &str = ",,4Htest,8Htest.igs,2Hpt,2Hpt,32,38,6,308,15,4Htest,1.,2,2HMM,1,0.1,\
+                      13H260101.000000,1.E-6,100.,2Hme,2Hus,11,0;";
+
 fn write_iges(ents: &[Ent]) -> String {
-    let global = ",,4Htest,8Htest.igs,2Hpt,2Hpt,32,38,6,308,15,4Htest,1.,2,2HMM,1,0.1,\
-                  13H260101.000000,1.E-6,100.,2Hme,2Hus,11,0;";
+    write_iges_global(GLOBAL, ents)
+}
+
+fn write_iges_global(global: &str, ents: &[Ent]) -> String {
     let entries: Vec<Entry> = ents
         .iter()
         .map(|e| Entry {
@@ -289,7 +295,7 @@ fn narrower_parameter_range_becomes_an_outer_loop_and_units_are_read() {
     let corners: Vec<DVec2> = (0..5).map(|i| trim_point(&seg.curve, i as f64)).collect();
     assert_eq!(corners[0], DVec2::new(0.25, 0.0));
     assert_eq!(corners[2], DVec2::new(0.75, 1.0));
-    assert_eq!(read.report.units, "MM");
+    assert_eq!(read.report.unit.name, "MM");
     assert!(read.report.lines()[0].contains("MM"));
 }
 
@@ -1345,4 +1351,23 @@ fn knot_of_multiplicity_degree_plus_one_is_a_break() {
         10.0,
         "start of the second piece",
     );
+}
+
+#[test]
+fn inch_file_is_read_into_millimetres() {
+    let n = net();
+    let mut surf = ent(128, &b128(&n, [0.0, 1.0, 0.0, 1.0]));
+    surf.subordinate = 0;
+    // Unit flag 1 (inches, §2.2.4.3.14): 25.4 mm each.
+    let global = GLOBAL.replacen(",2,2HMM,", ",1,4HINCH,", 1);
+    let text = write_iges_global(&global, &[surf]);
+    let read = parse_iges(Path::new("inch.igs"), &text)
+        .unwrap()
+        .into_millimetres();
+    assert_eq!(read.report.unit.name, "INCH");
+    assert!(read.report.lines()[0].starts_with("IGES units: INCH (25.4 mm)"));
+    let (s, _) = only(&read);
+    for (u, v) in grid() {
+        close(s.eval(u, v), net_point(&n, u, v) * 25.4, 100.0, "inch net");
+    }
 }
