@@ -18,11 +18,15 @@ fn gismo(name: &str) -> PathBuf {
 
 /// Each ray `[ox, oy, oz, dx, dy, dz]` hits within `tolerance` (mm) of OpenCASCADE's point.
 fn hits_as_occ(scene: &Path, rays: &[([f64; 6], [f64; 3])], tolerance: f64) {
+    hits_as_occ_with(scene, rays, tolerance, &[]);
+}
+
+fn hits_as_occ_with(scene: &Path, rays: &[([f64; 6], [f64; 3])], tolerance: f64, extra: &[&str]) {
     let text: String = rays
         .iter()
         .map(|(r, _)| format!("{} {} {} {} {} {}\n", r[0], r[1], r[2], r[3], r[4], r[5]))
         .collect();
-    let rows = common::trace_rows(scene, &text, &[]);
+    let rows = common::trace_rows(scene, &text, extra);
     for ((_, occ), row) in rays.iter().zip(&rows) {
         assert_eq!(
             row[1],
@@ -143,5 +147,55 @@ fn miscounted_hollerith_in_the_global_section_is_read_with_one_warning() {
             "bounds: [-17.4713751196072, -1.511404777835494, 0.0] .. [22.26938756285151, 39.01970722272699, 0.0]"
         ),
         "{out}"
+    );
+}
+
+#[test]
+fn clockwise_loop_across_the_seam_of_a_torus_bounds_the_rest_of_it() {
+    // HarmonyWare: one 144 over a closed 12 x 12 B-spline torus on [0, 2pi]^2, its outer
+    // loop u in [-pi/2, pi/2] (across the seam), v in [2.89, 3.96], clockwise: the face is
+    // the torus without that rectangle. Rays 0 and 1 of `bench/occ/run.sh
+    // testdata/cad/occt_OCC26138_Torus.igs --rays 300` and ray 2 (a random one) hit it
+    // far from the rectangle. Toth's kernel: the subdivision kernel does not yet
+    // converge on degree 12.
+    hits_as_occ_with(
+        &testdata("cad/occt_OCC26138_Torus.igs"),
+        &[
+            (
+                [
+                    -450.2177609289869,
+                    1460.8160326615312,
+                    -921.040608107085,
+                    0.3895952154419073,
+                    -0.6868203580034465,
+                    0.6135905507231931,
+                ],
+                [127.50653240383258, 442.3414974338234, -11.157341419201657],
+            ),
+            (
+                [
+                    -45.97832826417232,
+                    1684.1761548325435,
+                    -771.5129233409361,
+                    0.18050973752375032,
+                    -0.8215201552000937,
+                    0.540851984612353,
+                ],
+                [226.92199723176412, 442.1760232547117, 46.164198517457976],
+            ),
+            (
+                [
+                    -976.9753177996565,
+                    -928.9563589327954,
+                    -344.95275460130244,
+                    0.6825322420863397,
+                    0.6611724856219728,
+                    0.3114493261656806,
+                ],
+                [67.22264542905896, 82.56356680574117, 131.5298669918621],
+            ),
+        ],
+        MM,
+        &["--kernel", "toth"],
     );
 }
