@@ -37,7 +37,7 @@ fn pointer_positions(ty: i32, count: usize) -> Vec<usize> {
 fn repeated(src: &str, copies: usize) -> String {
     let path = Path::new("hammer.iges");
     let s = records::sections(path, src).unwrap();
-    let (delims, _) = records::global(path, &s.global).unwrap();
+    let (delims, _) = records::global(path, &s.global, &mut Vec::new()).unwrap();
     let entries = directory::entries(path, &s.directory).unwrap();
     let kept: Vec<&directory::DirEntry> = entries.iter().filter(|e| e.entity_type != 402).collect();
     let mut index = vec![0usize; 2 * entries.len() + 2];
@@ -49,9 +49,13 @@ fn repeated(src: &str, copies: usize) -> String {
     for copy in 0..copies {
         for e in &kept {
             let first = e.param_start - 1;
-            let tokens =
-                records::parameters(path, &s.parameters[first..first + e.param_count], delims)
-                    .unwrap();
+            let tokens = records::parameters(
+                path,
+                &s.parameters[first..first + e.param_count],
+                delims,
+                &mut Vec::new(),
+            )
+            .unwrap();
             let pointers = pointer_positions(e.entity_type, tokens.len());
             let fields = tokens
                 .iter()

@@ -321,11 +321,15 @@ fn check_box_range(path: &Path, name: &str, when: &str, b: &DAabb) -> Result<(),
     Ok(())
 }
 
-/// Reads an IGES file and prints what was not drawn as one warning line on stderr (and
-/// each surface that could not be converted), so nothing is dropped silently.
+/// Reads an IGES file into millimetres and prints what was not drawn as one warning line
+/// on stderr (and each surface that could not be converted), so nothing is dropped
+/// silently.
 fn read_iges_warning(path: &Path) -> Result<iges::Iges, LoadError> {
-    let read = iges::read_iges(path)?;
+    let read = iges::read_iges(path)?.into_millimetres();
     let r = &read.report;
+    for w in &r.warnings {
+        eprintln!("warning: {}: {w}", path.display());
+    }
     if let Some(line) = r.ignored_line() {
         eprintln!("warning: {}: {line}", path.display());
     }

@@ -43,7 +43,10 @@ fn info_prints_units_and_ignored_entities() {
     assert!(o.status.success(), "{}", stderr(&o));
     let out = stdout(&o);
     assert!(out.contains("patches: 162"), "{out}");
-    assert!(out.contains("IGES units: MM (model scale 1)"), "{out}");
+    assert!(
+        out.contains("IGES units: MM (1 mm), read in millimetres (model scale 1)"),
+        "{out}"
+    );
     assert!(
         out.contains("ignored: 1 × entity 402 (associativity)"),
         "{out}"

@@ -19,6 +19,7 @@ mod formats_cli;
 mod frames;
 mod hostile_input;
 mod iges;
+mod iges_writers;
 mod instances;
 mod lg6_cache_flags;
 mod man_pages;

@@ -57,9 +57,15 @@ fn de(k: usize) -> f64 {
     (2 * k + 1) as f64
 }
 
+/// The Global section of the test files: millimetres.
+const GLOBAL: &str = ",,4Htest,8Htest.igs,2Hpt,2Hpt,32,38,6,308,15,4Htest,1.,2,2HMM,1,0.1,\
+                      13H260101.000000,1.E-6,100.,2Hme,2Hus,11,0;";
+
 fn write_iges(ents: &[Ent]) -> String {
-    let global = ",,4Htest,8Htest.igs,2Hpt,2Hpt,32,38,6,308,15,4Htest,1.,2,2HMM,1,0.1,\
-                  13H260101.000000,1.E-6,100.,2Hme,2Hus,11,0;";
+    write_iges_global(GLOBAL, ents)
+}
+
+fn write_iges_global(global: &str, ents: &[Ent]) -> String {
     let entries: Vec<Entry> = ents
         .iter()
         .map(|e| Entry {
@@ -289,7 +295,7 @@ fn narrower_parameter_range_becomes_an_outer_loop_and_units_are_read() {
     let corners: Vec<DVec2> = (0..5).map(|i| trim_point(&seg.curve, i as f64)).collect();
     assert_eq!(corners[0], DVec2::new(0.25, 0.0));
     assert_eq!(corners[2], DVec2::new(0.75, 1.0));
-    assert_eq!(read.report.units, "MM");
+    assert_eq!(read.report.unit.name, "MM");
     assert!(read.report.lines()[0].contains("MM"));
 }
 
@@ -1270,4 +1276,98 @@ fn angles_beyond_a_turn_are_named_not_clamped() {
         "{:?}",
         read.report.failed
     );
+}
+
+/// A rational tensor-product point from Euclidean points and weights (u fastest), by the
+/// recursion above.
+#[allow(clippy::too_many_arguments)]
+fn rational_point(
+    [pu, pv]: [usize; 2],
+    [ku, kv]: [&[f64]; 2],
+    nu: usize,
+    pts: &[DVec3],
+    w: &[f64],
+    u: f64,
+    v: f64,
+) -> DVec3 {
+    let (mut num, mut den) = (DVec3::ZERO, 0.0);
+    for (k, (q, wk)) in pts.iter().zip(w).enumerate() {
+        let b = basis(k % nu, pu, ku, u) * basis(k / nu, pv, kv, v) * wk;
+        num += *q * b;
+        den += b;
+    }
+    num / den
+}
+
+#[test]
+fn knot_of_multiplicity_degree_plus_one_is_a_break() {
+    // Degree 2 × 1 with the u knot 1 repeated three times (degree + 1), as CATIA V4
+    // writes piecewise surfaces: two pieces of three columns each, and here the second
+    // is lifted by 5 so they do not meet. The surface is read whole, both pieces exact.
+    let ku = [0., 0., 0., 1., 1., 1., 2., 2., 2.];
+    let kv = [0., 0., 1., 1.];
+    let (mut pts, mut w) = (Vec::new(), Vec::new());
+    for j in 0..2 {
+        for i in 0..6 {
+            let lift = if i >= 3 { 5.0 } else { 0.0 };
+            pts.push(DVec3::new(
+                i as f64,
+                2.0 * j as f64,
+                lift + 0.3 * (i * j) as f64,
+            ));
+            w.push(1.0 + 0.25 * ((i + 2 * j) % 3) as f64);
+        }
+    }
+    let mut params = vec![5.0, 1.0, 2.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+    params.extend(ku);
+    params.extend(kv);
+    params.extend(&w);
+    for q in &pts {
+        params.extend([q.x, q.y, q.z]);
+    }
+    params.extend([0.0, 2.0, 0.0, 1.0]);
+    let mut surf = ent(128, &params);
+    surf.subordinate = 0;
+    let read = read(&[surf]);
+    let (n, _) = only(&read);
+    for (u, v) in grid() {
+        let u = 2.0 * u;
+        let expected = rational_point([2, 1], [&ku, &kv], 6, &pts, &w, u, v);
+        close(n.eval(u, v), expected, 10.0, &format!("({u}, {v})"));
+    }
+    // Two patches, one per piece, and the jump between them kept.
+    let patches = n.to_bezier_patches();
+    assert_eq!(patches.len(), 2);
+    // The ends of the two pieces are their corner control points.
+    close(
+        patches[0].eval(1.0, 0.0),
+        pts[2],
+        10.0,
+        "end of the first piece",
+    );
+    close(
+        patches[1].eval(0.0, 0.0),
+        pts[3],
+        10.0,
+        "start of the second piece",
+    );
+}
+
+#[test]
+fn inch_file_is_read_into_millimetres() {
+    let n = net();
+    let mut surf = ent(128, &b128(&n, [0.0, 1.0, 0.0, 1.0]));
+    surf.subordinate = 0;
+    // Unit flag 1 (inches, §2.2.4.3.14): 25.4 mm each.
+    let global = GLOBAL.replacen(",2,2HMM,", ",1,4HINCH,", 1);
+    let text = write_iges_global(&global, &[surf]);
+    let read = parse_iges(Path::new("inch.igs"), &text)
+        .unwrap()
+        .into_millimetres();
+    assert_eq!(read.report.unit.name, "INCH");
+    assert!(read.report.lines()[0].starts_with("IGES units: INCH (25.4 mm)"));
+    let (s, _) = only(&read);
+    for (u, v) in grid() {
+        close(s.eval(u, v), net_point(&n, u, v) * 25.4, 100.0, "inch net");
+    }
 }

@@ -5,7 +5,9 @@
 //! A5.6 raises every interior knot to multiplicity p in one sweep over the control
 //! polygon, emitting one Bézier segment per non-empty span: repeated knots form a single
 //! breakpoint, so zero-length spans never produce a piece. Each new point is a convex
-//! combination of old ones (as in Boehm insertion), so weights stay positive.
+//! combination of old ones (as in Boehm insertion), so weights stay positive. A knot of
+//! multiplicity p + 1 (a break, see `knots`) needs no insertion: the next segment is the
+//! p + 1 control points after it, as for multiplicity p.
 
 use glam::DVec4;
 
@@ -65,6 +67,9 @@ impl NurbsCurve {
                 points: current.clone(),
             });
             if b < m {
+                // At a break (multiplicity p + 1) the points of the next segment are the
+                // p + 1 after it, exactly as at multiplicity p.
+                let mult = mult.min(p);
                 next[p - mult..=p].copy_from_slice(&pw[b - mult..=b]);
                 std::mem::swap(&mut current, &mut next);
                 a = b;
@@ -133,9 +138,11 @@ mod tests {
     use crate::geom::nurbs::testutil::{breakpoints, diagonal, knot_vector, surface};
     use proptest::prelude::*;
 
-    /// The patch whose domain holds (u, v), and the local parameters there.
+    /// The patch whose domain holds (u, v), and the local parameters there; on a shared
+    /// edge the later patch, as evaluation takes the span to the right of a knot (A2.1),
+    /// which matters at a break.
     fn locate(patches: &[BezierPatch], u: f64, v: f64) -> Option<(&BezierPatch, f64, f64)> {
-        patches.iter().find_map(|p| {
+        patches.iter().rev().find_map(|p| {
             let d = p.domain();
             (d.u0 <= u && u <= d.u1 && d.v0 <= v && v <= d.v1)
                 .then(|| (p, (u - d.u0) / (d.u1 - d.u0), (v - d.v0) / (d.v1 - d.v0)))
@@ -169,7 +176,7 @@ mod tests {
         }
 
         /// A5.6 gives the same control points as inserting every interior knot up to
-        /// multiplicity p with A5.1 and cutting the polygon every p points.
+        /// multiplicity p with A5.1 and taking each span's p + 1 points.
         #[test]
         fn segments_match_repeated_insertion(
             (p, knots, points) in (1usize..=5, any::<bool>())
@@ -186,15 +193,20 @@ mod tests {
             let breaks = breakpoints(p, &curve.knots);
             for &t in &breaks[1..breaks.len() - 1] {
                 let s = knots::multiplicity(&inserted.knots, t);
-                inserted = inserted.insert_knot(t, p - s).unwrap();
+                if s < p {
+                    inserted = inserted.insert_knot(t, p - s).unwrap();
+                }
             }
             let segments = curve.bezier_segments();
             prop_assert_eq!(segments.len(), breaks.len() - 1);
-            prop_assert_eq!(inserted.points.len(), p * segments.len() + 1);
             let scale = curve.points.iter().map(|q| q.abs().max_element()).fold(0.0, f64::max);
             for (k, seg) in segments.iter().enumerate() {
                 prop_assert_eq!((seg.t0, seg.t1), (breaks[k], breaks[k + 1]));
-                for (a, b) in seg.points.iter().zip(&inserted.points[k * p..=k * p + p]) {
+                // Every interior knot now has multiplicity p or p + 1: the span starting
+                // at t0 (last knot index i with knots[i] <= t0) has the p + 1 points
+                // i - p ..= i (The NURBS Book P2.2).
+                let i = inserted.knots.partition_point(|&x| x <= seg.t0) - 1;
+                for (a, b) in seg.points.iter().zip(&inserted.points[i - p..=i]) {
                     prop_assert!((*a - *b).abs().max_element() <= 1e-13 * scale, "{} vs {}", a, b);
                 }
             }

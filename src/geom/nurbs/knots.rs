@@ -5,6 +5,12 @@
 //! non-decreasing knots; the surface is defined on `[knots[p], knots[n]]`. It need not be
 //! clamped (end knots repeated `p + 1` times): uniform and periodic vectors are accepted and
 //! clamped by knot insertion before decomposition (see `insert.rs`).
+//!
+//! An interior knot may be repeated up to `p + 1` times. At multiplicity `p + 1` no basis
+//! function spans the knot (The NURBS Book §2.2, property P2.2 and eq. 2.5): the curve
+//! is two independent pieces there, which meet only if their end control points do. CAD
+//! systems write such breaks (CATIA V4 IGES, piecewise Bézier data); the Bézier
+//! decomposition cuts there as at any other breakpoint.
 
 use thiserror::Error;
 
@@ -24,7 +30,7 @@ pub enum KnotError {
         value: f64,
     },
     #[error(
-        "interior knot {value} is repeated {multiplicity} times, more than the degree {degree}"
+        "interior knot {value} is repeated {multiplicity} times, more than degree + 1 = {}", .degree + 1
     )]
     InteriorMultiplicity {
         value: f64,
@@ -86,7 +92,7 @@ pub fn validate(degree: usize, knots: &[f64], count: usize) -> Result<(), KnotEr
                     degree,
                 });
             }
-        } else if multiplicity > degree {
+        } else if multiplicity > degree + 1 {
             return Err(KnotError::InteriorMultiplicity {
                 value,
                 multiplicity,
@@ -151,6 +157,15 @@ mod tests {
     fn accepts_clamped_uniform_and_interior_multiplicity() {
         assert!(validate(2, &[0., 0., 0., 0.5, 0.5, 1., 1., 1.], 5).is_ok());
         assert!(validate(3, &[0., 1., 2., 3., 4., 5., 6., 7.], 4).is_ok());
+        // A break: interior multiplicity degree + 1.
+        assert!(validate(1, &[0., 0., 1., 1., 2., 2.], 4).is_ok());
+        assert!(matches!(
+            validate(1, &[0., 0., 1., 1., 1., 2., 2.], 5),
+            Err(KnotError::InteriorMultiplicity {
+                multiplicity: 3,
+                ..
+            })
+        ));
         assert!(is_clamped(2, &[0., 0., 0., 1., 1., 1.]));
         assert!(!is_clamped(3, &[0., 1., 2., 3., 4., 5., 6., 7.]));
         assert_eq!(domain(3, &[0., 1., 2., 3., 4., 5., 6., 7.]), (3.0, 4.0));

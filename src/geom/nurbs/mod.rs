@@ -12,6 +12,7 @@
 //! - `shapes`: exact torus and sphere built from the 9-point circle.
 //! - `analytic`: analytic curves and surfaces (arcs, conics, planes, quadrics, tori,
 //!   revolutions, extrusions, ruled surfaces) as exact rational NURBS for the CAD readers.
+//! - `periodic`: a closed surface repeated over whole periods, for loops across its seam.
 //! - `inversion`: the closest point of a surface to a point (The NURBS Book §6.1).
 
 pub mod analytic;
@@ -21,6 +22,7 @@ pub mod decompose;
 pub mod insert;
 pub mod inversion;
 pub mod knots;
+pub mod periodic;
 pub mod shapes;
 pub mod surface;
 

@@ -252,14 +252,14 @@ mod tests {
     }
 
     #[test]
-    fn rejects_interior_multiplicity_above_degree() {
+    fn rejects_interior_multiplicity_above_degree_plus_one() {
         let mut a = args();
-        a.2 = vec![0., 0., 0., 0.5, 0.5, 0.5, 1., 1., 1.];
-        a.4 = 6;
-        a.6 = vec![DVec4::ONE; 12];
+        a.2 = vec![0., 0., 0., 0.5, 0.5, 0.5, 0.5, 1., 1., 1.];
+        a.4 = 7;
+        a.6 = vec![DVec4::ONE; 14];
         assert_eq!(
             message(a),
-            "knots_u: interior knot 0.5 is repeated 3 times, more than the degree 2"
+            "knots_u: interior knot 0.5 is repeated 4 times, more than degree + 1 = 3"
         );
     }
 

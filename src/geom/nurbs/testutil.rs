@@ -1,5 +1,5 @@
 //! Random NURBS for the property tests: degrees 1–5, knots on the domain [0, 1] with
-//! interior multiplicities 1..=p, clamped or with uniform unclamped ends, weights in
+//! interior multiplicities 1..=p + 1 (p + 1: a break), clamped or with uniform unclamped ends, weights in
 //! [0.1, 10] and control points in [-1, 1]³.
 
 use glam::{DVec3, DVec4};
@@ -14,9 +14,9 @@ const KNOT_GRID: u32 = 40;
 const END_SPACING: f64 = 0.15;
 
 /// A knot vector of degree `p` on the domain [0, 1]: up to 4 distinct interior knots, each
-/// repeated 1..=p times, and clamped ends or `p` extra uniformly spaced knots at each end.
+/// repeated 1..=p + 1 times, and clamped ends or `p` extra uniformly spaced knots at each end.
 pub fn knot_vector(p: usize, clamped: bool) -> impl Strategy<Value = Vec<f64>> {
-    prop::collection::vec((1..KNOT_GRID, 1..=p), 0..=4).prop_map(move |mut interior| {
+    prop::collection::vec((1..KNOT_GRID, 1..=p + 1), 0..=4).prop_map(move |mut interior| {
         interior.sort_by_key(|&(k, _)| k);
         interior.dedup_by_key(|&mut (k, _)| k);
         let mut knots: Vec<f64> = (0..=p)

@@ -21,6 +21,7 @@ pub mod entities;
 pub mod records;
 pub mod surfaces;
 pub mod trimmed;
+pub mod units;
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -29,7 +30,8 @@ use glam::{DAffine3, DVec3};
 
 use self::directory::DirEntry;
 use self::entities::{Entity, Params};
-use self::records::Value;
+use self::records::{Tolerated, Value};
+use self::units::LengthUnit;
 use crate::formats::error::ParseError;
 use crate::scene::model::Surface;
 
@@ -103,12 +105,14 @@ impl Model {
 }
 
 /// What reading found besides the surfaces: units, and what was not drawn.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Report {
-    /// Global parameter 15 (or the name of the unit flag, parameter 14).
-    pub units: String,
-    /// Global parameter 13, model space scale.
+    /// The declared length unit (Global parameters 14 and 15).
+    pub unit: LengthUnit,
+    /// Global parameter 13, model space scale (reported, not applied: see `units`).
     pub scale: f64,
+    /// What was tolerated or guessed, one line each, for the command line to print.
+    pub warnings: Vec<String>,
     /// Drawn entities of types that are not read, by type.
     pub ignored: BTreeMap<i32, usize>,
     /// Surfaces that could not be converted, with their directory sequence number.
@@ -123,8 +127,15 @@ impl Report {
     /// The lines `info` prints.
     pub fn lines(&self) -> Vec<String> {
         let mut out = vec![format!(
-            "IGES units: {} (model scale {})",
-            self.units, self.scale
+            "IGES units: {} ({} mm), read in millimetres (model scale {}{})",
+            self.unit.name,
+            self.unit.millimetres,
+            self.scale,
+            if self.scale == 1.0 {
+                ""
+            } else {
+                ", not applied, as OpenCASCADE reads it"
+            }
         )];
         if self.projected > 0 {
             out.push(format!(
@@ -208,28 +219,41 @@ pub struct Iges {
     pub report: Report,
 }
 
-/// Unit flag names (Global parameter 14, §2.2.4.3.14).
-fn unit_name(flag: i64) -> &'static str {
-    match flag {
-        1 => "INCH",
-        2 => "MM",
-        4 => "FT",
-        5 => "MI",
-        6 => "M",
-        7 => "KM",
-        8 => "MIL",
-        9 => "UM",
-        10 => "CM",
-        11 => "UIN",
-        _ => "unknown",
+impl Iges {
+    /// The surfaces scaled from the file's unit to millimetres, the convention of every
+    /// CAD format here (as OpenCASCADE reads IGES), and the projection error with them.
+    pub fn into_millimetres(mut self) -> Iges {
+        let k = self.report.unit.millimetres;
+        if k != 1.0 {
+            let m = DAffine3::from_scale(DVec3::splat(k));
+            for d in &mut self.surfaces {
+                d.surface.transform(&m);
+            }
+            self.report.max_projection_error *= k;
+        }
+        self
     }
+}
+
+/// One warning for the Hollerith strings read with a corrected count.
+fn tolerated_warning(t: &[Tolerated]) -> Option<String> {
+    let first = t.first()?;
+    Some(format!(
+        "{} Hollerith string(s) whose character count does not end at a delimiter, read up to the delimiter that follows (first at line {}, column {}: {} characters announced, {} before the delimiter)",
+        t.len(),
+        first.line,
+        first.column,
+        first.announced,
+        first.read
+    ))
 }
 
 /// Parses an IGES file. Syntax errors are located parse errors; surfaces that cannot be
 /// converted are reported, not fatal.
 pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
     let sections = records::sections(path, src)?;
-    let (delims, global) = records::global(path, &sections.global)?;
+    let mut tolerated = Vec::new();
+    let (delims, global) = records::global(path, &sections.global, &mut tolerated)?;
     let text = |i: usize| match global.get(i - 1).map(|t| &t.value) {
         Some(Value::Text(s)) => Some(s.clone()),
         _ => None,
@@ -238,15 +262,16 @@ pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
         Some(Value::Number { value, .. }) => Some(*value),
         _ => None,
     };
-    let flag = number(14).unwrap_or(1.0) as i64;
-    let units = match (flag, text(15)) {
-        (3, Some(name)) => name,
-        (f, _) => unit_name(f).to_string(),
-    };
+    let (unit, unit_warning) =
+        units::length_unit(number(14).map(|f| f as i64), text(15).as_deref());
     let mut report = Report {
-        units,
+        unit,
         scale: number(13).unwrap_or(1.0),
-        ..Default::default()
+        warnings: unit_warning.into_iter().collect(),
+        ignored: BTreeMap::new(),
+        failed: Vec::new(),
+        projected: 0,
+        max_projection_error: 0.0,
     };
     let entries = directory::entries(path, &sections.directory)?;
     let mut entities = Vec::with_capacity(entries.len());
@@ -274,7 +299,7 @@ pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
                     ),
                 )
             })?;
-        let tokens = records::parameters(path, records, delims)?;
+        let tokens = records::parameters(path, records, delims, &mut tolerated)?;
         let p = Params {
             path,
             entry,
@@ -302,6 +327,7 @@ pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
             t.contains("open cascade") || t.contains("opencascade")
         })
     });
+    report.warnings.extend(tolerated_warning(&tolerated));
     let model = Model {
         entries,
         entities,

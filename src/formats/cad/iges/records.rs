@@ -159,7 +159,11 @@ fn join(records: &[Record<'_>]) -> Joined {
 }
 
 /// Reads the Global section: its delimiters and its parameters (parameter 1 first).
-pub fn global(path: &Path, records: &[Record<'_>]) -> Result<(Delimiters, Vec<Token>), ParseError> {
+pub fn global(
+    path: &Path,
+    records: &[Record<'_>],
+    tolerated: &mut Vec<Tolerated>,
+) -> Result<(Delimiters, Vec<Token>), ParseError> {
     let j = join(records);
     let t = &j.text;
     let at = |i: usize| j.at(i);
@@ -214,7 +218,7 @@ pub fn global(path: &Path, records: &[Record<'_>]) -> Result<(Delimiters, Vec<To
         return Ok((delims, tokens));
     }
     expect_delim(pos, parameter)?;
-    let mut rest = tokenize(path, &j, pos + 1, delims)?;
+    let mut rest = tokenize(path, &j, pos + 1, delims, tolerated)?;
     tokens.append(&mut rest);
     Ok((delims, tokens))
 }
@@ -233,18 +237,71 @@ pub fn parameters(
     path: &Path,
     records: &[Record<'_>],
     delims: Delimiters,
+    tolerated: &mut Vec<Tolerated>,
 ) -> Result<Vec<Token>, ParseError> {
-    tokenize(path, &join(records), 0, delims)
+    tokenize(path, &join(records), 0, delims, tolerated)
+}
+
+/// A Hollerith string whose count was wrong, read up to the delimiter that shows where it
+/// ends.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tolerated {
+    pub line: usize,
+    pub column: usize,
+    pub announced: usize,
+    pub read: usize,
+}
+
+/// Whether a field that ends before byte `e` is followed (after spaces) by a delimiter.
+fn ends_field(t: &[u8], e: usize, delims: Delimiters) -> bool {
+    let mut i = e;
+    while t.get(i) == Some(&b' ') {
+        i += 1;
+    }
+    matches!(t.get(i), Some(&c) if c == delims.parameter || c == delims.record)
+}
+
+/// Where a Hollerith string whose count `declared` does not end at a delimiter was meant
+/// to end, when the records make it clear (writers miscount, e.g. Rhino 7 announces
+/// `38H` before a 32-character file name): a count reaching past a delimiter after
+/// which its record holds only blanks (the padding of a fixed-format record) ends at
+/// that delimiter; a count that stops short of the delimiter later on the same record
+/// ends there. Otherwise `None`: the string's end is a guess, and the file is refused.
+fn hollerith_intent(
+    j: &Joined,
+    body: usize,
+    declared: Option<usize>,
+    delims: Delimiters,
+) -> Option<usize> {
+    let t = &j.text;
+    let is_delim = |c: u8| c == delims.parameter || c == delims.record;
+    let line_of = |i: usize| j.origin[i].0;
+    let record_end = |i: usize| {
+        let line = line_of(i);
+        (i..t.len())
+            .find(|&k| line_of(k) != line)
+            .unwrap_or(t.len())
+    };
+    let reach = declared.unwrap_or(t.len());
+    let overshoot = (body..reach)
+        .find(|&d| is_delim(t[d]) && t[d + 1..record_end(d)].iter().all(|&c| c == b' '));
+    if overshoot.is_some() {
+        return overshoot;
+    }
+    let e = declared.filter(|&e| e < t.len())?;
+    (e..record_end(e)).find(|&d| is_delim(t[d]))
 }
 
 /// Free-format fields from `start` to the record delimiter (§2.2.2): numbers, Hollerith
 /// strings, or nothing (a defaulted field). Spaces around fields are ignored (outside
-/// strings). Text after the record delimiter is a comment.
+/// strings). Text after the record delimiter is a comment. Hollerith strings with a wrong
+/// count are read as [`hollerith_intent`] says and noted in `tolerated`.
 fn tokenize(
     path: &Path,
     j: &Joined,
     start: usize,
     delims: Delimiters,
+    tolerated: &mut Vec<Tolerated>,
 ) -> Result<Vec<Token>, ParseError> {
     let t = &j.text;
     let at = |i: usize| j.at(i);
@@ -270,14 +327,34 @@ fn tokenize(
                 .and_then(|s| s.parse().ok())
                 .unwrap_or(usize::MAX);
             let body = pos + digits + 1;
-            let end = body.checked_add(n).filter(|&e| e <= t.len()).ok_or_else(|| {
-                ParseError::new(
-                    path,
-                    line,
-                    column,
-                    format!("expected {n} characters of a Hollerith string, found the end of the entity's records"),
-                )
-            })?;
+            let declared = body.checked_add(n).filter(|&e| e <= t.len());
+            let end = match declared.filter(|&e| ends_field(t, e, delims)) {
+                Some(end) => end,
+                None => {
+                    let end = hollerith_intent(j, body, declared, delims).ok_or_else(|| {
+                        ParseError::new(
+                            path,
+                            line,
+                            column,
+                            match declared {
+                                Some(_) => format!(
+                                    "expected a delimiter after the {n} characters of a Hollerith string, and no delimiter nearby shows where it ends"
+                                ),
+                                None => format!(
+                                    "expected {n} characters of a Hollerith string, found the end of the entity's records"
+                                ),
+                            },
+                        )
+                    })?;
+                    tolerated.push(Tolerated {
+                        line,
+                        column,
+                        announced: n,
+                        read: end - body,
+                    });
+                    end
+                }
+            };
             pos = end;
             Value::Text(String::from_utf8_lossy(&t[body..end]).into_owned())
         } else {
@@ -355,7 +432,12 @@ mod tests {
 
     #[test]
     fn global_declares_its_delimiters() {
-        let (d, t) = global(Path::new("g"), &[rec("1H//1H#/4HA/B;/1.5D2#")]).unwrap();
+        let (d, t) = global(
+            Path::new("g"),
+            &[rec("1H//1H#/4HA/B;/1.5D2#")],
+            &mut Vec::new(),
+        )
+        .unwrap();
         assert_eq!((d.parameter, d.record), (b'/', b'#'));
         assert_eq!(t[2].value, Value::Text("A/B;".into()));
         assert_eq!(
@@ -365,7 +447,7 @@ mod tests {
                 integer: false
             }
         );
-        let (d, t) = global(Path::new("g"), &[rec(",,3Hxyz,2;")]).unwrap();
+        let (d, t) = global(Path::new("g"), &[rec(",,3Hxyz,2;")], &mut Vec::new()).unwrap();
         assert_eq!((d.parameter, d.record), (b',', b';'));
         assert_eq!(
             t[3].value,
@@ -382,7 +464,13 @@ mod tests {
             parameter: b',',
             record: b';',
         };
-        let t = parameters(Path::new("p"), &[rec("110, 1.,,-3.E1;  comment")], d).unwrap();
+        let t = parameters(
+            Path::new("p"),
+            &[rec("110, 1.,,-3.E1;  comment")],
+            d,
+            &mut Vec::new(),
+        )
+        .unwrap();
         assert_eq!(t.len(), 4);
         assert_eq!(t[2].value, Value::Empty);
         assert_eq!(
@@ -393,12 +481,56 @@ mod tests {
             }
         );
         assert_eq!((t[1].line, t[1].column), (7, 6));
-        let e = parameters(Path::new("p"), &[rec("110,1.x,2;")], d).unwrap_err();
+        let e = parameters(Path::new("p"), &[rec("110,1.x,2;")], d, &mut Vec::new()).unwrap_err();
         assert_eq!(
             e.to_string(),
             "p:7:5: expected a number, a Hollerith string or an empty field, found `1.x`"
         );
-        let e = parameters(Path::new("p"), &[rec("110,1,2")], d).unwrap_err();
+        let e = parameters(Path::new("p"), &[rec("110,1,2")], d, &mut Vec::new()).unwrap_err();
         assert!(e.to_string().contains("record delimiter"), "{e}");
+    }
+
+    #[test]
+    fn miscounted_hollerith_strings_end_at_the_delimiter_that_shows_where() {
+        let d = Delimiters {
+            parameter: b',',
+            record: b';',
+        };
+        // Too long: the count runs over `,` into the blank padding of its record.
+        let (a, b) = ("406,9HABCD,", "  2;");
+        let records = [
+            Record {
+                data: &format!("{a:<20}"),
+                line: 3,
+            },
+            Record { data: b, line: 4 },
+        ];
+        let mut tolerated = Vec::new();
+        let t = parameters(Path::new("p"), &records, d, &mut tolerated).unwrap();
+        assert_eq!(t[1].value, Value::Text("ABCD".into()));
+        assert_eq!(
+            t[2].value,
+            Value::Number {
+                value: 2.0,
+                integer: true
+            }
+        );
+        assert_eq!(
+            tolerated,
+            [Tolerated {
+                line: 3,
+                column: 5,
+                announced: 9,
+                read: 4
+            }]
+        );
+        // Too short: the delimiter follows later on the same record.
+        let mut tolerated = Vec::new();
+        let t = parameters(Path::new("p"), &[rec("406,2HABCD,3;")], d, &mut tolerated).unwrap();
+        assert_eq!(t[1].value, Value::Text("ABCD".into()));
+        assert_eq!(tolerated[0].read, 4);
+        // No delimiter shows the end: refused, located at the string.
+        let e = parameters(Path::new("p"), &[rec("406,2HABCD")], d, &mut Vec::new()).unwrap_err();
+        assert_eq!((e.line, e.column), (7, 5), "{e}");
     }
 }

@@ -15,9 +15,10 @@ use super::elementary::{self, Placed};
 use super::entities::{Elementary, Entity};
 use super::surfaces::{self, Converted};
 use super::{Model, Report};
+use crate::geom::nurbs::NurbsSurface;
 use crate::geom::nurbs::analytic::{self, Frame};
 use crate::geom::nurbs::inversion::Inverter;
-use crate::geom::trim::{ParamCurve, TrimLoop, TrimSegment};
+use crate::geom::trim::{AxisMap, ParamCurve, TrimLoop, TrimSegment};
 use crate::scene::model::{Surface, SurfaceGeometry};
 
 /// Points per Bézier segment of a model-space trim curve that are projected; the loop
@@ -514,18 +515,104 @@ fn control_box(trims: &[TrimLoop]) -> (DVec2, DVec2) {
 }
 
 /// The surface with its loops; a 128 whose range is narrower than its knots and that has
-/// no outer loop gets the range as one (its domain, §4.24, is the range).
-fn finish(c: Converted, mut loops: Vec<TrimLoop>) -> Surface {
+/// no outer loop gets the range as one (its domain, §4.24, is the range). A surface closed
+/// in a direction whose loops reach across its seam is repeated over the periods they
+/// reach (see `geom::nurbs::periodic`).
+fn finish(mut c: Converted, mut loops: Vec<TrimLoop>) -> Surface {
     if let Some([u0, u1, v0, v1]) = c.range
         && loops.iter().all(|l| l.hole)
     {
         loops.insert(0, rectangle(u0, u1, v0, v1));
+    }
+    if !loops.is_empty() && c.maps == <[AxisMap; 2]>::default() {
+        let size = net_size(&c.surface);
+        let closed = [c.surface.is_closed_u(CLOSED * size), {
+            c.surface.transposed().is_closed_u(CLOSED * size)
+        }];
+        if closed == [true, true] {
+            complement_clockwise_outer(&c.surface, &mut loops);
+        }
+        c.surface = across_seams(c.surface, control_box(&loops), closed);
     }
     Surface {
         geometry: SurfaceGeometry::Nurbs(c.surface),
         trims: loops,
         trim_space: c.maps,
     }
+}
+
+/// A surface is closed in a direction when its first and last control points there meet
+/// within this fraction of the net's size: writers round the seam's points alike, so this
+/// only needs to be above the file's rounding.
+const CLOSED: f64 = 1e-7;
+
+/// Loops reaching at most this many whole periods beyond a closed surface's domain are
+/// followed there; farther is not a seam crossing but a wrong parameterisation.
+const MAX_PERIODS: f64 = 2.0;
+
+/// On a surface closed in both directions (a torus) a loop that does not go around bounds
+/// two regions, and which one is meant is the loop's orientation: OpenCASCADE keeps the
+/// region to the left of the wire (checked on `occt_OCC26138_Torus.igs`: its one outer
+/// boundary runs clockwise, and OpenCASCADE's face is the torus without the rectangle the
+/// loop draws, over a full period in u and v). So a lone outer loop running clockwise
+/// becomes a hole in one period of the surface that starts at the loop's lower corner.
+fn complement_clockwise_outer(s: &NurbsSurface, loops: &mut Vec<TrimLoop>) {
+    let outer: Vec<usize> = (0..loops.len()).filter(|&i| !loops[i].hole).collect();
+    let [i] = outer[..] else { return };
+    if signed_area(&loops[i]) >= 0.0 {
+        return;
+    }
+    let (lo, _) = control_box(std::slice::from_ref(&loops[i]));
+    let d = s.domain();
+    let (tu, tv) = (d.u1 - d.u0, d.v1 - d.v0);
+    loops[i].hole = true;
+    loops.insert(0, rectangle(lo.x, lo.x + tu, lo.y, lo.y + tv));
+}
+
+/// The signed area of a loop's control polygon (shoelace; positive counter-clockwise):
+/// its sign is the loop's orientation for the simple loops trims are.
+fn signed_area(l: &TrimLoop) -> f64 {
+    let points: Vec<DVec2> = l
+        .segments
+        .iter()
+        .flat_map(|s| &s.curve.points)
+        .map(|q| DVec2::new(q.x / q.z, q.y / q.z))
+        .collect();
+    let n = points.len();
+    (0..n)
+        .map(|k| points[k].perp_dot(points[(k + 1) % n]))
+        .sum::<f64>()
+        / 2.0
+}
+
+/// `s` repeated over the periods the loops' box `(lo, hi)` reaches beyond its domain in
+/// each direction in which it is `closed`.
+fn across_seams(mut s: NurbsSurface, (lo, hi): (DVec2, DVec2), closed: [bool; 2]) -> NurbsSurface {
+    for k in 0..2 {
+        let d = s.domain();
+        let (a, b) = if k == 0 { (d.u0, d.u1) } else { (d.v0, d.v1) };
+        let period = b - a;
+        let periods = |x: f64| (x / period - 1e-9).ceil().clamp(0.0, MAX_PERIODS) as usize;
+        let (before, after) = (periods(a - lo[k]), periods(hi[k] - b));
+        if before + after > 0 && closed[k] {
+            let t = if k == 0 { s.clone() } else { s.transposed() };
+            let r = t.repeated_u(before, after);
+            s = if k == 0 { r } else { r.transposed() };
+        }
+    }
+    s
+}
+
+/// The diagonal of the box of a surface's control points.
+fn net_size(s: &NurbsSurface) -> f64 {
+    let (lo, hi) = s
+        .points
+        .iter()
+        .map(|p| p.truncate() / p.w)
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p), hi.max(p))
+        });
+    (hi - lo).length()
 }
 
 fn rectangle(u0: f64, u1: f64, v0: f64, v1: f64) -> TrimLoop {
