@@ -135,7 +135,7 @@ impl NurbsSurface {
 mod tests {
     use super::*;
     use crate::geom::nurbs::knots;
-    use crate::geom::nurbs::testutil::{breakpoints, diagonal, knot_vector, surface};
+    use crate::geom::nurbs::testutil::{breakpoints, knot_vector, surface};
     use proptest::prelude::*;
 
     /// The patch whose domain holds (u, v), and the local parameters there; on a shared
@@ -167,7 +167,7 @@ mod tests {
                     breakpoints(s.degree_v, &s.knots_v)[b]));
                 prop_assert_eq!((p.degree_u(), p.degree_v()), (s.degree_u, s.degree_v));
             }
-            let tolerance = 1e-12 * diagonal(&s);
+            let tolerance = 1e-12 * s.net_diagonal();
             for (u, v) in params {
                 let (patch, lu, lv) = locate(&patches, u, v).expect("patches cover the domain");
                 let dev = (patch.eval(lu, lv) - s.eval(u, v)).length();

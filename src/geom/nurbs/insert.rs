@@ -140,7 +140,7 @@ impl NurbsSurface {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::nurbs::testutil::{diagonal, surface};
+    use crate::geom::nurbs::testutil::surface;
     use proptest::prelude::*;
 
     /// Largest distance between two surfaces over a grid on the domain of `a`.
@@ -174,7 +174,7 @@ mod tests {
             prop_assert_eq!(new_knots.len(), knots.len() + times);
             prop_assert_eq!(r.domain(), s.domain());
             let dev = max_deviation(&s, &r);
-            prop_assert!(dev <= 1e-12 * diagonal(&s), "deviation {}", dev);
+            prop_assert!(dev <= 1e-12 * s.net_diagonal(), "deviation {}", dev);
         }
 
         #[test]
@@ -195,7 +195,7 @@ mod tests {
             prop_assert_eq!(r.domain(), rect);
             // Compared on the restricted domain: the same points as the original there.
             let dev = max_deviation(&r, &s);
-            prop_assert!(dev <= 1e-12 * diagonal(&s), "deviation {}", dev);
+            prop_assert!(dev <= 1e-12 * s.net_diagonal(), "deviation {}", dev);
         }
 
         #[test]
@@ -206,7 +206,7 @@ mod tests {
             prop_assert!(knots::is_clamped(c.degree_v, &c.knots_v));
             prop_assert_eq!(c.domain(), s.domain());
             let dev = max_deviation(&s, &c);
-            prop_assert!(dev <= 1e-12 * diagonal(&s), "deviation {}", dev);
+            prop_assert!(dev <= 1e-12 * s.net_diagonal(), "deviation {}", dev);
         }
     }
 
@@ -234,7 +234,7 @@ mod tests {
             vec![2.0, 2.0, 2.0, 2.0, 2.0, 2.5, 3.0, 3.0, 3.0, 3.0, 3.0]
         );
         assert_eq!((c.count_u, c.count_v), (7, 6));
-        assert!(max_deviation(&s, &c) <= 1e-12 * diagonal(&s));
+        assert!(max_deviation(&s, &c) <= 1e-12 * s.net_diagonal());
     }
 
     #[test]

@@ -33,6 +33,19 @@ pub(super) fn knot_error(direction: &'static str) -> impl Fn(KnotError) -> GeomE
 }
 
 impl NurbsSurface {
+    /// The diagonal of the box of the Euclidean control points: the surface's scale for
+    /// tolerances (the surface lies in their convex hull).
+    pub fn net_diagonal(&self) -> f64 {
+        let (lo, hi) = self
+            .points
+            .iter()
+            .map(|p| p.truncate() / p.w)
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p), hi.max(p))
+            });
+        (hi - lo).length()
+    }
+
     /// Validates and builds a surface.
     ///
     /// # Examples

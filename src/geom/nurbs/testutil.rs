@@ -63,18 +63,6 @@ pub fn surface() -> impl Strategy<Value = NurbsSurface> {
         })
 }
 
-/// The diagonal of the box of the Euclidean control points, the scale for tolerances.
-pub fn diagonal(s: &NurbsSurface) -> f64 {
-    let (lo, hi) = s
-        .points
-        .iter()
-        .map(|p| p.truncate() / p.w)
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
-            (lo.min(p), hi.max(p))
-        });
-    (hi - lo).length()
-}
-
 /// The distinct knot values inside the domain: the breakpoints between non-empty spans,
 /// counted independently of the decomposition code.
 pub fn breakpoints(p: usize, knots: &[f64]) -> Vec<f64> {

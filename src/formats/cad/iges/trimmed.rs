@@ -525,7 +525,7 @@ fn finish(mut c: Converted, mut loops: Vec<TrimLoop>) -> Surface {
         loops.insert(0, rectangle(u0, u1, v0, v1));
     }
     if !loops.is_empty() && c.maps == <[AxisMap; 2]>::default() {
-        let size = net_size(&c.surface);
+        let size = c.surface.net_diagonal();
         let closed = [c.surface.is_closed_u(CLOSED * size), {
             c.surface.transposed().is_closed_u(CLOSED * size)
         }];
@@ -601,18 +601,6 @@ fn across_seams(mut s: NurbsSurface, (lo, hi): (DVec2, DVec2), closed: [bool; 2]
         }
     }
     s
-}
-
-/// The diagonal of the box of a surface's control points.
-fn net_size(s: &NurbsSurface) -> f64 {
-    let (lo, hi) = s
-        .points
-        .iter()
-        .map(|p| p.truncate() / p.w)
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
-            (lo.min(p), hi.max(p))
-        });
-    (hi - lo).length()
 }
 
 fn rectangle(u0: f64, u1: f64, v0: f64, v1: f64) -> TrimLoop {
