@@ -327,6 +327,9 @@ fn check_box_range(path: &Path, name: &str, when: &str, b: &DAabb) -> Result<(),
 fn read_iges_warning(path: &Path) -> Result<iges::Iges, LoadError> {
     let read = iges::read_iges(path)?.into_millimetres();
     let r = &read.report;
+    if read.surfaces.is_empty() {
+        return Err(nothing_renderable(path, r));
+    }
     for w in &r.warnings {
         eprintln!("warning: {}: {w}", path.display());
     }
@@ -345,6 +348,30 @@ fn read_iges_warning(path: &Path) -> Result<iges::Iges, LoadError> {
         );
     }
     Ok(read)
+}
+
+/// The error for an IGES file none of whose entities became a surface: what it held that
+/// was not read, and why each surface failed (the first few), so that it never reads as an
+/// empty scene.
+fn nothing_renderable(path: &Path, r: &iges::Report) -> LoadError {
+    const SHOWN: usize = 5;
+    let mut why = vec!["nothing to render: no surface was read".to_string()];
+    why.extend(r.ignored_line());
+    if r.ignored.is_empty() && r.failed.is_empty() {
+        why.push("its entities are curves, points and structure only".into());
+    }
+    if !r.failed.is_empty() {
+        let more = r.failed.len().saturating_sub(SHOWN);
+        let mut failed = r.failed[..r.failed.len().min(SHOWN)].join("; ");
+        if more > 0 {
+            failed.push_str(&format!("; and {more} more"));
+        }
+        why.push(format!(
+            "{} surface(s) not converted: {failed}",
+            r.failed.len()
+        ));
+    }
+    LoadError::invalid(path, why.join("; "))
 }
 
 /// A bare IGES file as a scene: one object per colour (IGES 314 or the Directory Entry's

@@ -119,3 +119,62 @@ fn import_to_ron_keeps_trims_and_trim_spaces() {
     });
     assert!(arcs);
 }
+
+/// An IGES file with no surface (one line entity) is an error that says so and what the
+/// file held, not an empty scene: exit status 2 for `info` and `render`, no image.
+#[test]
+fn an_iges_file_without_surfaces_is_refused_saying_what_it_held() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(testdata("trimmed_patch.igs")).unwrap();
+    let card = |data: &str, section: char, seq: usize| format!("{data:<72}{section}{seq:>7}\n");
+    let mut igs = card("one line entity, no surface", 'S', 1);
+    // The Global section of a valid file, as it is.
+    for g in text.lines().filter(|l| l.chars().nth(72) == Some('G')) {
+        igs.push_str(g);
+        igs.push('\n');
+    }
+    igs.push_str(&card(
+        "     110       1       0       0       0       0       0       000010000",
+        'D',
+        1,
+    ));
+    igs.push_str(&card(
+        "     110       0       0       1       0                               0",
+        'D',
+        2,
+    ));
+    igs.push_str(&card(
+        &format!("{:<64} {:>7}", "110,0.,0.,0.,1.,0.,0.;", 1),
+        'P',
+        1,
+    ));
+    let globals = text
+        .lines()
+        .filter(|l| l.chars().nth(72) == Some('G'))
+        .count();
+    igs.push_str(&card(
+        &format!("S      1G{globals:>7}D      2P      1"),
+        'T',
+        1,
+    ));
+    let path = dir.path().join("line.igs");
+    std::fs::write(&path, igs).unwrap();
+    let out = dir.path().join("x.png");
+    for args in [
+        vec!["info", path.to_str().unwrap()],
+        vec![
+            "render",
+            path.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+        ],
+    ] {
+        let o = run(&args);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains("nothing to render"), "{err}");
+        assert!(err.contains("curves, points and structure only"), "{err}");
+    }
+    assert!(!out.exists());
+}
