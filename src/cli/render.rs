@@ -126,7 +126,16 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         .into());
     }
     let pool = thread_pool(args.threads)?;
-    let mut prepared = prepare(&args.scene, &args.mesh, &args.kernel, args.quiet)?;
+    // The image window is checked as soon as the camera is read, before the BVH is built.
+    let check = |scene: &crate::scene::Scene| {
+        let c = &scene.camera;
+        let size = (
+            args.size.width.unwrap_or(c.width),
+            args.size.height.unwrap_or(c.height),
+        );
+        window(&args, size.0, size.1).map(|_| ())
+    };
+    let mut prepared = prepare(&args.scene, &args.mesh, &args.kernel, args.quiet, &check)?;
     args.size.apply(&args.scene, &mut prepared.scene)?;
     let plan = EffectPlan {
         trims: prepared.trims,
@@ -150,6 +159,23 @@ pub fn run(args: RenderArgs) -> anyhow::Result<ExitCode> {
         render_frame(&prepared, &args, &pool, (frame, plan), &output)?;
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The part of the `width` × `height` image this render makes: `--crop`, `--tile` or the
+/// whole image, refused (bad input) when it does not fit or its film is over budget.
+fn window(args: &RenderArgs, width: u32, height: u32) -> Result<Window, crate::cli::BadArgument> {
+    let window = match (args.crop, args.tile) {
+        (Some(crop), _) => {
+            crop.check(width, height)
+                .map_err(|e| crate::cli::BadArgument(format!("--crop {crop}: {e}")))?;
+            crop
+        }
+        (None, Some(tile)) => Window::tile(tile, width, height).map_err(crate::cli::BadArgument)?,
+        (None, None) => Window::full(width, height),
+    };
+    crate::scene::check_film_pixels(window.width(), window.height())
+        .map_err(crate::cli::BadArgument)?;
+    Ok(window)
 }
 
 /// Renders one frame of the prepared scene, whose camera is posed for it, to `output`.
@@ -176,17 +202,7 @@ fn render_frame(
         .or(scene.samples.map(SampleCount::Fixed))
         .unwrap_or_default();
     let (width, height) = (scene.camera.width, scene.camera.height);
-    let window = match (args.crop, args.tile) {
-        (Some(crop), _) => {
-            crop.check(width, height)
-                .map_err(|e| crate::cli::BadArgument(format!("--crop {crop}: {e}")))?;
-            crop
-        }
-        (None, Some(tile)) => Window::tile(tile, width, height).map_err(crate::cli::BadArgument)?,
-        (None, None) => Window::full(width, height),
-    };
-    crate::scene::check_film_pixels(window.width(), window.height())
-        .map_err(crate::cli::BadArgument)?;
+    let window = window(args, width, height)?;
     let aovs = aov::expand(&args.aov);
     let job = RenderJob {
         order: args.order,

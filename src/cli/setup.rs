@@ -115,13 +115,18 @@ pub fn print_warnings(scene: &Scene) {
     }
 }
 
-/// Loads the scene and prepares its geometry: builds the BVH or loads `--bvh`, or builds
-/// the grid for `--accel grid`, with progress unless `quiet`.
+/// A check of the command's own flags against the scene as read (its camera), made before
+/// the geometry is prepared, so that a bad flag costs no BVH build.
+pub type SceneCheck<'a> = dyn Fn(&Scene) -> Result<(), crate::cli::BadArgument> + 'a;
+
+/// Loads the scene, runs `check` on it, and prepares its geometry: builds the BVH or loads
+/// `--bvh`, or builds the grid for `--accel grid`, with progress unless `quiet`.
 pub fn prepare(
     scene_path: &Path,
     mesh: &MeshArgs,
     args: &KernelArgs,
     quiet: bool,
+    check: &SceneCheck,
 ) -> anyhow::Result<Prepared> {
     ensure_arg!(
         args.accel == AccelChoice::Bvh || args.bvh.is_none(),
@@ -129,9 +134,10 @@ pub fn prepare(
     );
     let start = Instant::now();
     if let (AccelChoice::Bvh, Some(path)) = (args.accel, &args.bvh) {
-        return prepare_from_file(scene_path, mesh, args, path, quiet);
+        return prepare_from_file(scene_path, mesh, args, path, (quiet, check));
     }
     let (mut scene, source_key) = load_keyed(scene_path, mesh, quiet, (false, None))?;
+    check(&scene)?;
     let trims = TrimEffect::of(&scene, args.ignore_trims);
     if args.ignore_trims {
         scene = scene.without_trims();
@@ -184,7 +190,7 @@ fn prepare_from_file(
     mesh: &MeshArgs,
     args: &KernelArgs,
     bvh_path: &Path,
-    quiet: bool,
+    (quiet, check): (bool, &SceneCheck),
 ) -> anyhow::Result<Prepared> {
     let start = Instant::now();
     let opened = crate::accel::mapped::map(bvh_path)?;
@@ -194,6 +200,7 @@ fn prepare_from_file(
         != Some(crate::formats::load::InputKind::Ron);
     let parsed = (!bare || opened.has_patches()).then(|| opened.cached_scene());
     let (scene, source) = load_keyed(scene_path, mesh, quiet, (true, parsed))?;
+    check(&scene)?;
     let load_seconds = start.elapsed().as_secs_f64();
     let start = Instant::now();
     let key = crate::accel::mapped::key(source, args.ignore_trims);

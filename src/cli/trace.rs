@@ -28,7 +28,9 @@ pub const CHUNK_RAYS: usize = 1 << 16;
 pub fn run(args: TraceArgs) -> anyhow::Result<ExitCode> {
     let file = std::fs::File::open(&args.rays).map_err(|e| LoadError::io(&args.rays, e))?;
     let mut rays = RayChunks::new(&args.rays, std::io::BufReader::new(file));
-    let prepared = prepare(&args.scene, &args.mesh, &args.kernel, args.quiet)?;
+    let prepared = prepare(&args.scene, &args.mesh, &args.kernel, args.quiet, &|_| {
+        Ok(())
+    })?;
     let precision = precision(&args.kernel, &prepared.scene.camera)?;
     let pool = thread_pool(args.threads)?;
     // A bad line found mid-file stops the output; the error is kept here because the
