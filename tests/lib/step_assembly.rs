@@ -20,13 +20,7 @@ const X: DVec3 = DVec3::Y;
 /// rep, its origin placement, context).
 fn component() -> (StepWriter, u64, u64, u64) {
     let mut w = StepWriter::default();
-    let ax = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
-    let plane = w.add(format!("PLANE('',#{ax})"));
-    let sq = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
-    let b = w.polygon_bound(&sq, true);
-    let face = w.face(&[b], plane);
-    let shell = w.add(format!("OPEN_SHELL('',(#{face}))"));
-    let model = w.add(format!("SHELL_BASED_SURFACE_MODEL('',(#{shell}))"));
+    let model = w.unit_square_model();
     let ctx = w.add("(GEOMETRIC_REPRESENTATION_CONTEXT(3) REPRESENTATION_CONTEXT('',''))");
     let origin = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
     let rep = w.add(format!(

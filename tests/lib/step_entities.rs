@@ -751,13 +751,7 @@ fn styled_item_colours_become_materials() {
 #[test]
 fn assembly_occurrences_are_instances_of_one_part_with_their_placements() {
     let mut w = StepWriter::default();
-    let ax = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
-    let plane = w.add(format!("PLANE('',#{ax})"));
-    let sq = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
-    let b = w.polygon_bound(&sq, true);
-    let face = w.face(&[b], plane);
-    let shell = w.add(format!("OPEN_SHELL('',(#{face}))"));
-    let model = w.add(format!("SHELL_BASED_SURFACE_MODEL('',(#{shell}))"));
+    let model = w.unit_square_model();
     let mm = w.add("(LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.))");
     let ctx = w.add(format!(
         "(GEOMETRIC_REPRESENTATION_CONTEXT(3) GLOBAL_UNIT_ASSIGNED_CONTEXT((#{mm})) REPRESENTATION_CONTEXT('',''))"

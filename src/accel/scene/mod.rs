@@ -20,8 +20,8 @@ pub use file::FromFile;
 
 use glam::DVec3;
 
-use crate::accel::bvh::Bvh;
-use crate::accel::grid::Grid;
+use crate::accel::bvh::{Bvh, TraversalStats};
+use crate::accel::grid::{Grid, GridStats};
 use crate::accel::instance::Placement;
 use crate::accel::patches::PatchStore;
 use crate::geom::Aabb;
@@ -49,6 +49,22 @@ impl QueryStats {
         self.bvh_box_tests += o.bvh_box_tests;
         self.voxels_visited += o.voxels_visited;
         self.surface_tests += o.surface_tests;
+    }
+
+    /// Adds a BVH traversal's counts: the instances' work `nested`, the traversal `t`
+    /// itself, and the primitives of the leaves it reached.
+    fn add_bvh(&mut self, nested: &QueryStats, t: &TraversalStats, surface_tests: u64) {
+        self.add(nested);
+        self.nodes_visited += t.nodes_visited;
+        self.bvh_box_tests += t.box_tests;
+        self.surface_tests += surface_tests;
+    }
+
+    /// Adds a grid traversal's counts: its tight-box tests are the surfaces tested.
+    fn add_grid(&mut self, g: &GridStats) {
+        self.voxels_visited += g.voxels_visited;
+        self.bvh_box_tests += g.box_tests;
+        self.surface_tests += g.box_tests;
     }
 }
 

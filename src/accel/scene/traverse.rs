@@ -180,10 +180,7 @@ impl SceneGeometry {
             }
             ControlFlow::Continue(())
         });
-        stats.add(&nested);
-        stats.nodes_visited += t.nodes_visited;
-        stats.bvh_box_tests += t.box_tests;
-        stats.surface_tests += surface_tests;
+        stats.add_bvh(&nested, &t, surface_tests);
         best
     }
 
@@ -239,10 +236,7 @@ impl SceneGeometry {
                 ControlFlow::Continue(())
             }
         });
-        stats.add(&nested);
-        stats.nodes_visited += t.nodes_visited;
-        stats.bvh_box_tests += t.box_tests;
-        stats.surface_tests += surface_tests;
+        stats.add_bvh(&nested, &t, surface_tests);
         hit
     }
 
@@ -273,9 +267,7 @@ impl SceneGeometry {
                 Some(hit.t)
             }
         });
-        stats.voxels_visited += g.voxels_visited;
-        stats.bvh_box_tests += g.box_tests;
-        stats.surface_tests += g.box_tests;
+        stats.add_grid(&g);
         best
     }
 
@@ -300,9 +292,7 @@ impl SceneGeometry {
                 triangle::intersect_triangle(&shear, a, b, c, ray.tmin, ray.tmax).is_some()
             }
         });
-        stats.voxels_visited += g.voxels_visited;
-        stats.bvh_box_tests += g.box_tests;
-        stats.surface_tests += g.box_tests;
+        stats.add_grid(&g);
         hit
     }
 }

@@ -162,6 +162,19 @@ impl StepWriter {
         self.bound(&edges, outer)
     }
 
+    /// The unit square [0, 1]² at z = 0 as one planar face of an open shell, in a
+    /// SHELL_BASED_SURFACE_MODEL (whose id is returned): the smallest part a placement test
+    /// can aim at.
+    pub fn unit_square_model(&mut self) -> u64 {
+        let ax = self.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
+        let plane = self.add(format!("PLANE('',#{ax})"));
+        let sq = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
+        let b = self.polygon_bound(&sq, true);
+        let face = self.face(&[b], plane);
+        let shell = self.add(format!("OPEN_SHELL('',(#{face}))"));
+        self.add(format!("SHELL_BASED_SURFACE_MODEL('',(#{shell}))"))
+    }
+
     /// A full circle as one closed edge (one vertex at angle 0), as a bound.
     pub fn circle_bound(&mut self, centre: DVec3, z: DVec3, x: DVec3, r: f64, outer: bool) -> u64 {
         let ax = self.axis(centre, z, x);

@@ -83,11 +83,7 @@ pub fn occurrences(
     // The representation holding each item (for MAPPED_ITEMs).
     let mut item_owner: HashMap<u64, u64> = HashMap::new();
     for inst in &res.ex.instances {
-        let Some(r) = inst
-            .records
-            .iter()
-            .find(|r| r.name.ends_with("SHAPE_REPRESENTATION") && r.params.len() >= 3)
-        else {
+        let Some(r) = inst.shape_representation() else {
             continue;
         };
         let rec = Rec {

@@ -207,11 +207,7 @@ fn held(ex: &records::Exchange, faces: usize) -> String {
     let mut items: BTreeMap<String, usize> = BTreeMap::new();
     let mut seen: HashSet<u64> = HashSet::new();
     for inst in &ex.instances {
-        let Some(r) = inst
-            .records
-            .iter()
-            .find(|r| r.name.ends_with("SHAPE_REPRESENTATION") && r.params.len() >= 3)
-        else {
+        let Some(r) = inst.shape_representation() else {
             continue;
         };
         let Some(records::Value::List(list)) = r.params.get(1).map(|p| &p.value) else {

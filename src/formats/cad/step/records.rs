@@ -58,6 +58,15 @@ impl<'a> Instance<'a> {
         self.records.iter().find(|r| r.name == name)
     }
 
+    /// The instance's shape representation record (`SHAPE_REPRESENTATION` or a subtype
+    /// such as `ADVANCED_BREP_SHAPE_REPRESENTATION`, whose attributes are name, items and
+    /// context of items), when it is one.
+    pub fn shape_representation(&self) -> Option<&Record<'a>> {
+        self.records
+            .iter()
+            .find(|r| r.name.ends_with("SHAPE_REPRESENTATION") && r.params.len() >= 3)
+    }
+
     /// The type name: the record's for a simple instance, the records' names joined by
     /// `+` for a complex one.
     pub fn type_name(&self) -> Cow<'a, str> {
