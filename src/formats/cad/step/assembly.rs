@@ -23,6 +23,7 @@ use std::collections::HashMap;
 use glam::DAffine3;
 
 use super::entities::{Rec, Resolver};
+use super::items;
 use super::records::Value;
 use crate::formats::error::ParseError;
 
@@ -44,17 +45,6 @@ pub struct Occurrence {
     /// The context holding the representation's units.
     pub context: Option<u64>,
 }
-
-/// Geometry items the reader converts.
-pub const GEOMETRY_ITEMS: [&str; 7] = [
-    "MANIFOLD_SOLID_BREP",
-    "BREP_WITH_VOIDS",
-    "SHELL_BASED_SURFACE_MODEL",
-    "CLOSED_SHELL",
-    "OPEN_SHELL",
-    "ADVANCED_FACE",
-    "FACE_SURFACE",
-];
 
 /// Items that carry no geometry of their own (placements, presentation), or that place
 /// another representation (MAPPED_ITEM, followed as a link).
@@ -100,7 +90,7 @@ pub fn occurrences(
             };
             item_owner.entry(id).or_insert(inst.id);
             let name = item.records[0].name;
-            if GEOMETRY_ITEMS.contains(&name) {
+            if items::is_geometry(item) {
                 items.push(id);
             } else if !NON_GEOMETRY_ITEMS.contains(&name) {
                 *unsupported

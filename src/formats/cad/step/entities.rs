@@ -502,7 +502,7 @@ impl<'e, 'a> Resolver<'e, 'a> {
         self.unsupported.borrow_mut().take()
     }
 
-    fn unsupported(&self, r: &Rec, what: &str) -> ParseError {
+    pub(super) fn unsupported(&self, r: &Rec, what: &str) -> ParseError {
         *self.unsupported.borrow_mut() = Some(r.inst.type_name().into_owned());
         r.error(format!("expected {what}"))
     }
@@ -534,7 +534,7 @@ impl<'e, 'a> Resolver<'e, 'a> {
     }
 
     /// Runs `f` one reference level deeper, failing past [`MAX_DEPTH`].
-    fn deeper<T>(
+    pub(super) fn deeper<T>(
         &self,
         from: &Rec,
         f: impl FnOnce() -> Result<T, ParseError>,
@@ -552,7 +552,7 @@ impl<'e, 'a> Resolver<'e, 'a> {
     }
 
     /// Follows parameter `i` of `from` to an instance that must be one of `types`.
-    fn follow<'r>(
+    pub(super) fn follow<'r>(
         &'r self,
         from: &Rec,
         i: usize,
@@ -563,7 +563,7 @@ impl<'e, 'a> Resolver<'e, 'a> {
         self.expect_type(from, id, types, i)
     }
 
-    fn expect_type<'r>(
+    pub(super) fn expect_type<'r>(
         &'r self,
         from: &Rec,
         id: u64,
@@ -680,7 +680,13 @@ impl<'e, 'a> Resolver<'e, 'a> {
                 .bspline_curve(inst, &self.rec(inst))
                 .map(Curve::BSpline);
         }
-        let r = self.rec(inst);
+        // A complex instance (BOUNDED_CURVE() CURVE() … SURFACE_CURVE(…), as Alias and
+        // AutoCAD write the curves bounding a CURVE_BOUNDED_SURFACE) is read by the record
+        // that defines its curve.
+        let r = ["SURFACE_CURVE", "SEAM_CURVE", "BOUNDED_SURFACE_CURVE"]
+            .iter()
+            .find_map(|n| self.named(inst, n))
+            .unwrap_or_else(|| self.rec(inst));
         match r.rec.name {
             "LINE" => {
                 let origin = self.point(&r, 1)?;
@@ -702,10 +708,13 @@ impl<'e, 'a> Resolver<'e, 'a> {
                 b: r.positive(3, "semi_axis_2")?,
             }),
             "TRIMMED_CURVE" => self.trimmed_curve(&r),
-            "SURFACE_CURVE" | "SEAM_CURVE" => {
-                let curve = self.curve(&r, 1)?;
+            "SURFACE_CURVE" | "SEAM_CURVE" | "BOUNDED_SURFACE_CURVE" => {
+                // (name, curve_3d, associated_geometry, master_representation); in a
+                // complex instance the name belongs to REPRESENTATION_ITEM's record.
+                let off = usize::from(!inst.complex);
+                let curve = self.curve(&r, off)?;
                 let mut pcurves = Vec::new();
-                for p in r.list(2, "associated geometry (pcurves)")? {
+                for p in r.list(off + 1, "associated geometry (pcurves)")? {
                     let id = r.reference_of(p, "a PCURVE")?;
                     let pc = self.instance(&r, id)?;
                     if pc.record("PCURVE").is_some() {
@@ -728,6 +737,12 @@ impl<'e, 'a> Resolver<'e, 'a> {
         let r = self.rec(inst);
         let surface = r.reference(1, "the basis surface")?;
         let rep = self.follow(&r, 2, &["DEFINITIONAL_REPRESENTATION"])?;
+        // As a complex instance (AutoCAD: DEFINITIONAL_REPRESENTATION() REPRESENTATION(…)
+        // SHAPE_REPRESENTATION()) the items are REPRESENTATION's.
+        let rep = self
+            .named(rep.inst, "REPRESENTATION")
+            .filter(|x| x.rec.params.len() >= 2)
+            .unwrap_or(rep);
         let items = rep.references(1, "representation items")?;
         let first = items
             .first()
@@ -929,6 +944,13 @@ impl<'e, 'a> Resolver<'e, 'a> {
                     direction: dir * magnitude,
                 })
             }
+            // Inside a face (or under a curve-bounded surface) a rectangular trimmed
+            // surface is its basis: ISO 10303-42 §4.4.? gives it the basis's own
+            // parameterisation, and the face's bounds lie within the rectangle. Standing
+            // alone it is read as its rectangle (`surfaces`).
+            "RECTANGULAR_TRIMMED_SURFACE" => Ok((*self
+                .surface_by_id(&r, r.reference(1, "a basis surface")?)?)
+            .clone()),
             "OFFSET_SURFACE" => {
                 let basis = self.surface_by_id(&r, r.reference(1, "a basis surface")?)?;
                 let distance = r.real(2, "a distance")?;
@@ -939,7 +961,7 @@ impl<'e, 'a> Resolver<'e, 'a> {
                     )
                 })
             }
-            _ => Err(self.unsupported(&r, "a supported surface (PLANE, CYLINDRICAL_SURFACE, CONICAL_SURFACE, SPHERICAL_SURFACE, TOROIDAL_SURFACE, SURFACE_OF_REVOLUTION, SURFACE_OF_LINEAR_EXTRUSION, B_SPLINE_SURFACE_WITH_KNOTS, BEZIER_SURFACE, UNIFORM_SURFACE, QUASI_UNIFORM_SURFACE, OFFSET_SURFACE)")),
+            _ => Err(self.unsupported(&r, "a supported surface (PLANE, CYLINDRICAL_SURFACE, CONICAL_SURFACE, SPHERICAL_SURFACE, TOROIDAL_SURFACE, SURFACE_OF_REVOLUTION, SURFACE_OF_LINEAR_EXTRUSION, B_SPLINE_SURFACE_WITH_KNOTS, BEZIER_SURFACE, UNIFORM_SURFACE, QUASI_UNIFORM_SURFACE, OFFSET_SURFACE, RECTANGULAR_TRIMMED_SURFACE)")),
         }
     }
 

@@ -6,6 +6,9 @@
 //! - `geometry`: curves and surfaces evaluated by their definitions, converted to exact
 //!   rational NURBS through the shared `geom::nurbs::analytic`.
 //! - `topology`: faces and their bounds to trim loops in each surface's parameter domain.
+//! - `items`: what a representation holds (solids, shells, surface models, geometric sets)
+//!   down to what is rendered: faces, `surfaces` standing alone (curve-bounded,
+//!   rectangular-trimmed, bare), and `tessellated` items as triangles.
 //! - `assembly`, `units`, `style`: placements of parts, length units, colours.
 //!
 //! Malformed files (syntax, wrong parameter kinds, dangling references) are errors located
@@ -17,9 +20,12 @@
 pub mod assembly;
 pub mod entities;
 pub mod geometry;
+pub mod items;
 pub mod lexer;
 pub mod records;
 pub mod style;
+pub mod surfaces;
+pub mod tessellated;
 pub mod topology;
 pub mod units;
 
@@ -34,7 +40,7 @@ use self::style::Colour;
 use self::units::Units;
 use super::scene::{self, CadModel, DeclaredUnit, Failure, Part, Piece, Shape};
 use crate::formats::error::{LoadError, ParseError};
-use crate::scene::model::{Material, Object, Surface};
+use crate::scene::model::{Material, Object, TriangleMesh};
 
 /// What reading a STEP file found beyond the geometry.
 #[derive(Clone, Debug, Default)]
@@ -42,7 +48,13 @@ pub struct Report {
     pub schemas: Vec<String>,
     pub units: Units,
     pub faces: usize,
-    /// Faces that could not be converted: `(#id, why)`.
+    /// Surfaces converted outside faces (in geometric sets and surface models).
+    pub surfaces: usize,
+    /// Tessellated items read and their triangles.
+    pub tessellated: usize,
+    pub triangles: usize,
+    /// Faces (and standalone surfaces, tessellated items) that could not be converted:
+    /// `(#id, why)`.
     pub failed_faces: Vec<(u64, String)>,
     /// Entities left unread, by type.
     pub unsupported: BTreeMap<String, usize>,
@@ -59,7 +71,7 @@ impl Report {
     /// One line per fact, for `info` (what was skipped and failed is added by the
     /// [CAD front door](crate::formats::cad::scene)).
     pub fn lines(&self) -> Vec<String> {
-        vec![
+        let mut lines = vec![
             format!(
                 "STEP schema: {}",
                 if self.schemas.is_empty() {
@@ -86,7 +98,20 @@ impl Report {
                 "projected edges: {}, largest projection error {:.3e} mm",
                 self.projected_edges, self.max_projection_error
             ),
-        ]
+        ];
+        if self.surfaces > 0 {
+            lines.push(format!(
+                "surfaces outside faces: {} converted (geometric sets, surface models)",
+                self.surfaces
+            ));
+        }
+        if self.tessellated > 0 {
+            lines.push(format!(
+                "tessellated items: {}, {} triangles",
+                self.tessellated, self.triangles
+            ));
+        }
+        lines
     }
 }
 
@@ -100,45 +125,6 @@ pub struct StepModel {
 
 fn located(path: &Path, e: lexer::LexError) -> ParseError {
     ParseError::new(path, e.line as usize, e.column as usize, e.message)
-}
-
-/// The faces of a geometry item with the colour each inherits (its own, else the
-/// nearest styled container's).
-fn item_faces(
-    res: &Resolver,
-    id: u64,
-    colours: &HashMap<u64, Colour>,
-    inherited: Option<Colour>,
-    out: &mut Vec<(u64, Option<Colour>)>,
-    depth: usize,
-) -> Result<(), ParseError> {
-    let Some(inst) = res.ex.get(id) else {
-        return Ok(());
-    };
-    let colour = colours.get(&id).copied().or(inherited);
-    let r = res.rec(inst);
-    let children: Vec<u64> = match r.rec.name {
-        "ADVANCED_FACE" | "FACE_SURFACE" => {
-            out.push((id, colour));
-            return Ok(());
-        }
-        "MANIFOLD_SOLID_BREP" => vec![r.reference(1, "the outer CLOSED_SHELL")?],
-        "BREP_WITH_VOIDS" => {
-            let mut v = vec![r.reference(1, "the outer CLOSED_SHELL")?];
-            v.extend(r.references(2, "void shells")?);
-            v
-        }
-        "CLOSED_SHELL" | "OPEN_SHELL" => r.references(1, "faces")?,
-        "SHELL_BASED_SURFACE_MODEL" => r.references(1, "shells")?,
-        _ => return Ok(()),
-    };
-    if depth > 8 {
-        return Err(r.error("shells nest too deep (a reference cycle?)"));
-    }
-    for c in children {
-        item_faces(res, c, colours, colour, out, depth + 1)?;
-    }
-    Ok(())
 }
 
 /// Reads a STEP file for the [CAD front door](crate::formats::cad::scene).
@@ -265,44 +251,60 @@ pub fn read_model(path: &Path, src: &str) -> Result<(CadModel, Report), ParseErr
     report.occurrences = occurrences.len();
     let colours = style::colours(&ex);
     let size = model_size(&ex);
-    // Faces resolved once, in file order (the resolver's caches are not shared), then
-    // converted on every core (each face on its own), then placed per occurrence.
-    let mut placed: Vec<Vec<(u64, Option<Colour>)>> = Vec::with_capacity(occurrences.len());
-    let mut resolved: Vec<(u64, entities::Face)> = Vec::new();
+    // Leaves (faces, standalone surfaces, tessellated items) resolved once, in file
+    // order (the resolver's caches are not shared), then converted on every core (each on
+    // its own), then placed per occurrence.
+    let mut placed: Vec<Vec<items::Leaf>> = Vec::with_capacity(occurrences.len());
+    let mut resolved: Vec<(u64, Source)> = Vec::new();
     let mut seen: HashSet<u64> = HashSet::new();
     for occ in &occurrences {
-        let mut faces = Vec::new();
+        let mut leaves = Vec::new();
         for &item in &occ.items {
-            item_faces(&res, item, &colours, None, &mut faces, 0)?;
+            items::leaves(&res, item, &colours, &mut unsupported, &mut leaves)?;
         }
-        for &(fid, _) in &faces {
-            if seen.insert(fid)
-                && let Some(face) = resolve_face(&res, fid, &mut report, &mut unsupported)?
+        for &(id, _) in &leaves {
+            if seen.insert(id)
+                && let Some(source) = resolve(&res, id, &mut report, &mut unsupported)?
             {
-                resolved.push((fid, face));
+                resolved.push((id, source));
             }
         }
-        placed.push(faces);
+        placed.push(leaves);
     }
     // Tolerances follow the faces' own extent where they have edges: files hold points
     // far from their faces (CATIA's k1 key: a wireframe kilometres wide).
-    let size = topology::faces_extent(resolved.iter().map(|(_, f)| f)).unwrap_or(size);
-    let outcomes: Vec<(u64, Result<topology::FaceOutcome, String>)> = resolved
-        .par_iter()
-        .map(|(fid, face)| (*fid, topology::convert_face(face, size)))
+    let size = topology::faces_extent(resolved.iter().filter_map(|(_, s)| match s {
+        Source::Face(f) | Source::Standalone(surfaces::Standalone::Face(f)) => Some(f),
+        _ => None,
+    }))
+    .unwrap_or(size);
+    let outcomes: Vec<(u64, Result<Converted, String>)> = resolved
+        .into_par_iter()
+        .map(|(id, source)| (id, convert(source, size)))
         .collect();
-    let mut converted: HashMap<u64, Surface> = HashMap::new();
-    for (fid, outcome) in outcomes {
+    let mut converted: HashMap<u64, Shape> = HashMap::new();
+    for (id, outcome) in outcomes {
         match outcome {
-            Ok(out) => {
+            Ok(Converted::Face(out)) => {
+                report.faces += 1;
                 report.projected_edges += out.projected_edges;
                 report.max_projection_error = report.max_projection_error.max(out.projection_error);
-                converted.insert(fid, out.surface);
+                converted.insert(id, Shape::Surface(out.surface));
             }
-            Err(why) => report.failed_faces.push((fid, why)),
+            Ok(Converted::Surface(out)) => {
+                report.surfaces += 1;
+                report.projected_edges += out.projected_edges;
+                report.max_projection_error = report.max_projection_error.max(out.projection_error);
+                converted.insert(id, Shape::Surface(out.surface));
+            }
+            Ok(Converted::Mesh(mesh)) => {
+                report.tessellated += 1;
+                report.triangles += mesh.indices.len();
+                converted.insert(id, Shape::Triangles(mesh));
+            }
+            Err(why) => report.failed_faces.push((id, why)),
         }
     }
-    report.faces = converted.len();
     report.failed_faces.sort_by_key(|(id, _)| *id);
     report.max_projection_error *= report.units.length.factor;
     let mut model = CadModel::new(
@@ -323,14 +325,14 @@ pub fn read_model(path: &Path, src: &str) -> Result<(CadModel, Report), ParseErr
                 pieces: faces
                     .iter()
                     .filter_map(|(fid, colour)| {
-                        let surface = converted.get(fid)?;
+                        let shape = converted.get(fid)?;
                         if let Some(c) = colour
                             && !palette.contains(c)
                         {
                             palette.push(*c);
                         }
                         Some(Piece {
-                            shape: Shape::Surface(surface.clone()),
+                            shape: shape.clone(),
                             colour: colour.map(|c| c.0),
                         })
                     })
@@ -353,33 +355,80 @@ pub fn read_model(path: &Path, src: &str) -> Result<(CadModel, Report), ParseErr
         .failed_faces
         .iter()
         .map(|(id, why)| Failure {
-            entity: format!("#{id}"),
+            // Leaves other than faces say what they are.
+            entity: match ex.get(*id) {
+                Some(i) if items::kind(i) != items::Kind::Face => {
+                    format!("#{id} ({})", i.type_name())
+                }
+                _ => format!("#{id}"),
+            },
             why: why.clone(),
         })
         .collect();
     Ok((model, report))
 }
 
-/// The entities of face `fid`; a face that is valid STEP but uses what the reader does not
+/// A leaf read: a face, a surface standing alone, or triangles.
+enum Source {
+    Face(entities::Face),
+    Standalone(surfaces::Standalone),
+    Mesh(TriangleMesh),
+}
+
+/// A leaf converted: a face's or a standalone surface's trimmed surface (with what its
+/// conversion measured), or triangles.
+enum Converted {
+    Face(topology::FaceOutcome),
+    Surface(topology::FaceOutcome),
+    Mesh(TriangleMesh),
+}
+
+/// Converts one leaf; the error says why it could not be (the caller names it). `size`
+/// is the model's size, which the tolerances are relative to.
+fn convert(source: Source, size: f64) -> Result<Converted, String> {
+    Ok(match source {
+        Source::Face(f) => Converted::Face(topology::convert_face(&f, size)?),
+        Source::Standalone(surfaces::Standalone::Face(f)) => {
+            Converted::Surface(topology::convert_face(&f, size)?)
+        }
+        Source::Standalone(surfaces::Standalone::Patch(p)) => {
+            Converted::Surface(topology::FaceOutcome {
+                surface: surfaces::convert_patch(&p)?,
+                projection_error: 0.0,
+                projected_edges: 0,
+            })
+        }
+        Source::Mesh(m) if m.indices.is_empty() => return Err("it holds no triangle".into()),
+        Source::Mesh(m) => Converted::Mesh(m),
+    })
+}
+
+/// The entities of leaf `id`; a leaf that is valid STEP but uses what the reader does not
 /// convert is recorded in the report and gives `None`, a malformed one is an error.
-fn resolve_face(
+fn resolve(
     res: &Resolver,
-    fid: u64,
+    id: u64,
     report: &mut Report,
     unsupported: &mut BTreeMap<String, usize>,
-) -> Result<Option<entities::Face>, ParseError> {
-    let Some(inst) = res.ex.get(fid) else {
+) -> Result<Option<Source>, ParseError> {
+    let Some(inst) = res.ex.get(id) else {
         return Ok(None);
     };
     res.take_unsupported();
-    match res.face(inst) {
-        Ok(f) => Ok(Some(f)),
+    let read = match items::kind(inst) {
+        items::Kind::Face => res.face(inst).map(Source::Face),
+        items::Kind::Surface => surfaces::read(res, inst).map(Source::Standalone),
+        items::Kind::Tessellated => tessellated::read(res, inst).map(Source::Mesh),
+        _ => return Ok(None),
+    };
+    match read {
+        Ok(s) => Ok(Some(s)),
         Err(e) => match res.take_unsupported() {
             Some(kind) => {
                 *unsupported.entry(kind.clone()).or_default() += 1;
                 report
                     .failed_faces
-                    .push((fid, format!("uses {kind}, which is not supported")));
+                    .push((id, format!("uses {kind}, which is not supported")));
                 Ok(None)
             }
             None => Err(e),
