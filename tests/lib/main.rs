@@ -37,6 +37,7 @@ mod step_assembly;
 mod step_entities;
 mod step_faces;
 mod step_part;
+mod step_sets;
 mod subdiv_surface;
 mod subdiv_tessellate;
 mod tess_mesh;

@@ -27,6 +27,8 @@ pub struct StepWriter {
     pub lines: Vec<String>,
     pub next: u64,
     pub faces: Vec<u64>,
+    /// Further items of the shape representation (geometric sets, tessellated items).
+    pub items: Vec<u64>,
     /// Length unit: `None` for millimetres, or a conversion-based unit (name, mm).
     pub unit: Option<(String, f64)>,
     /// Plane-angle unit in degrees instead of radians.
@@ -267,8 +269,11 @@ impl StepWriter {
             "(GEOMETRIC_REPRESENTATION_CONTEXT(3) GLOBAL_UNIT_ASSIGNED_CONTEXT((#{length},#{angle},#{sr})) REPRESENTATION_CONTEXT('',''))"
         ));
         let origin = self.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
+        let mut items = vec![origin, model];
+        items.extend(&self.items);
         self.add(format!(
-            "MANIFOLD_SURFACE_SHAPE_REPRESENTATION('',(#{origin},#{model}),#{ctx})"
+            "MANIFOLD_SURFACE_SHAPE_REPRESENTATION('',{},#{ctx})",
+            refs(&items)
         ));
         self.text()
     }
