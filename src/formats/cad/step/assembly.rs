@@ -18,7 +18,7 @@
 //! Plain SHAPE_REPRESENTATION_RELATIONSHIPs join a part's representations (its placements
 //! and its B-rep) into one part.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use glam::DAffine3;
 
@@ -107,6 +107,25 @@ pub fn occurrences(
     let components = Components::of(res);
     // Links between representations.
     let mut links = Vec::new();
+    // A shape aspect's representation draws only what its product's own representations do
+    // not already hold (OpenCASCADE's STEPControl_ActorRead: an aspect whose items are
+    // already translated names a portion of the shape, e.g. the solid for validation
+    // properties or a datum's face; otherwise it is an AP203 hybrid model's geometry, part
+    // of the product). Drawing it as a root of its own would repeat the solid at the origin
+    // of the assembly, wherever the product is placed.
+    let held = held_by(res, &reps, &components.aspects);
+    for (&rep, &pd) in &components.aspects {
+        if let Some((items, _)) = reps.get_mut(&rep) {
+            items.retain(|i| !held.contains(i));
+        }
+        if let Some(&main) = components.reps.get(&pd).and_then(|r| r.first()) {
+            links.push(Link {
+                child: rep,
+                parent: main,
+                transform: None,
+            });
+        }
+    }
     for inst in &res.ex.instances {
         let Some(r) = inst
             .record("REPRESENTATION_RELATIONSHIP")
@@ -201,7 +220,7 @@ pub fn occurrences(
         members.entry(root).or_default().push(id);
     }
     let mut children: HashMap<u64, Vec<(u64, DAffine3)>> = HashMap::new();
-    let mut is_child: std::collections::HashSet<u64> = Default::default();
+    let mut is_child: HashSet<u64> = HashSet::new();
     for l in &links {
         if let Some(t) = l.transform {
             let (c, p) = (find(&mut part, l.child), find(&mut part, l.parent));
@@ -262,6 +281,57 @@ pub fn occurrences(
     Ok(out)
 }
 
+/// Topological items that a representation outside `aspects` holds, directly or inside a
+/// solid or shell it holds (ISO 10303-42 §5.4: a solid's shells, a shell's faces).
+fn held_by(
+    res: &Resolver,
+    reps: &HashMap<u64, (Vec<u64>, Option<u64>)>,
+    aspects: &HashMap<u64, u64>,
+) -> HashSet<u64> {
+    let mut held = HashSet::new();
+    let mut stack: Vec<u64> = reps
+        .iter()
+        .filter(|(rep, _)| !aspects.contains_key(rep))
+        .flat_map(|(_, (items, _))| items.iter().copied())
+        .collect();
+    while let Some(id) = stack.pop() {
+        let Some(inst) = res.ex.get(id) else {
+            continue;
+        };
+        if !TOPOLOGY.contains(&inst.records[0].name) || !held.insert(id) {
+            continue;
+        }
+        for r in &inst.records {
+            push_references(&r.params, &mut stack);
+        }
+    }
+    held
+}
+
+/// The entities a solid or shell is made of, down to its faces.
+const TOPOLOGY: [&str; 10] = [
+    "MANIFOLD_SOLID_BREP",
+    "BREP_WITH_VOIDS",
+    "SHELL_BASED_SURFACE_MODEL",
+    "CLOSED_SHELL",
+    "OPEN_SHELL",
+    "ORIENTED_CLOSED_SHELL",
+    "ORIENTED_OPEN_SHELL",
+    "CONNECTED_FACE_SET",
+    "ADVANCED_FACE",
+    "FACE_SURFACE",
+];
+
+fn push_references(params: &[crate::formats::cad::step::records::Param], out: &mut Vec<u64>) {
+    for p in params {
+        match &p.value {
+            Value::Ref(id) => out.push(*id),
+            Value::List(items) => push_references(items, out),
+            _ => {}
+        }
+    }
+}
+
 /// Which representations belong to the component of each assembly relationship: the
 /// relationship's CONTEXT_DEPENDENT_SHAPE_REPRESENTATION → PRODUCT_DEFINITION_SHAPE →
 /// NEXT_ASSEMBLY_USAGE_OCCURRENCE (relating: the assembly, related: the component), and
@@ -271,6 +341,10 @@ struct Components {
     usage: HashMap<u64, (u64, u64)>,
     /// Product definition → its shape representations.
     reps: HashMap<u64, Vec<u64>>,
+    /// Representation of a shape aspect (ISO 10303-41: a portion of a product's shape, by
+    /// SHAPE_DEFINITION_REPRESENTATION of a PROPERTY_DEFINITION of the aspect) → the product
+    /// definition whose shape it belongs to.
+    aspects: HashMap<u64, u64>,
 }
 
 impl Components {
@@ -299,12 +373,29 @@ impl Components {
                 defines.insert(inst.id, *d);
             }
         }
+        let mut aspects = HashMap::new();
+        // A shape aspect (any subtype: SHAPE_ASPECT, DATUM_FEATURE, …) names its product
+        // definition shape as its third attribute, `of_shape`.
+        let aspect_of = |property: u64| {
+            let p = ex.get(property)?.record("PROPERTY_DEFINITION")?;
+            let Some(Value::Ref(aspect)) = p.params.get(2).map(|q| &q.value) else {
+                return None;
+            };
+            let a = ex.get(*aspect)?;
+            a.records.iter().find_map(|r| match r.params.get(2)?.value {
+                Value::Ref(pds) => defines.get(&pds).copied(),
+                _ => None,
+            })
+        };
         for inst in &ex.instances {
             if let Some(p) = refs(inst, "SHAPE_DEFINITION_REPRESENTATION")
-                && let (Some(Some(pds)), Some(Some(rep))) = (p.first(), p.get(1))
-                && let Some(&pd) = defines.get(pds)
+                && let (Some(Some(def)), Some(Some(rep))) = (p.first(), p.get(1))
             {
-                reps.entry(pd).or_default().push(*rep);
+                if let Some(&pd) = defines.get(def) {
+                    reps.entry(pd).or_default().push(*rep);
+                } else if let Some(pd) = aspect_of(*def) {
+                    aspects.insert(*rep, pd);
+                }
             }
             if let Some(p) = refs(inst, "CONTEXT_DEPENDENT_SHAPE_REPRESENTATION")
                 && let (Some(Some(rel)), Some(Some(pds))) = (p.first(), p.get(1))
@@ -321,7 +412,11 @@ impl Components {
                 usage.insert(*rel, (*a, *c));
             }
         }
-        Components { usage, reps }
+        Components {
+            usage,
+            reps,
+            aspects,
+        }
     }
 
     /// Whether relationship `rel` between `rep_1` and `rep_2` has its component in `rep_2`.
