@@ -4,7 +4,7 @@ use std::io::Write;
 use std::process::ExitCode;
 
 use crate::cli::args::InfoArgs;
-use crate::formats::load::{InputKind, load_scene_noted};
+use crate::formats::load::load_scene_noted;
 use crate::scene::summary::summarize;
 
 pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
@@ -99,14 +99,6 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
     writeln!(out, "max depth: {}", s.max_depth)?;
     for note in notes {
         writeln!(out, "{note}")?;
-    }
-    if InputKind::of(&args.scene) == Some(InputKind::Iges) {
-        for line in crate::formats::cad::iges::read_iges(&args.scene)?
-            .report
-            .lines()
-        {
-            writeln!(out, "{line}")?;
-        }
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -6,7 +6,6 @@ use super::cad::{iges, scene, step};
 use super::error::LoadError;
 use super::{bpt, cage, gltf_mesh, mesh, obj, pbrt, ron_format};
 use crate::geom::bbox::DAabb;
-use crate::scene::model::Material;
 use crate::scene::model::{Axis, Geometry, Object, Scene, Surface};
 
 /// The kinds of input file we read, by extension.
@@ -76,13 +75,7 @@ pub fn load_geometry_noted(path: &Path) -> Result<(Geometry, Vec<String>), LoadE
         }
         InputKind::Gltf => Ok(Geometry::Mesh(gltf_mesh::read_gltf(path)?)),
         InputKind::Stl => Ok(Geometry::Mesh(super::stl::read_stl(path)?)),
-        InputKind::Iges => Ok(Geometry::Surfaces(
-            read_iges_warning(path)?
-                .surfaces
-                .into_iter()
-                .map(|d| d.surface)
-                .collect(),
-        )),
+        InputKind::Iges => return scene::build_geometry(path, iges::read_cad(path)?),
         InputKind::Step => return scene::build_geometry(path, step::read_step(path)?),
         InputKind::Ron => Err(LoadError::invalid(
             path,
@@ -210,7 +203,7 @@ pub fn load_scene_keyed(
 }
 
 /// [`load_scene_with`], with what the reader noted about the file beyond the scene (a
-/// STEP file's units, unsupported entities, faces left out), one line each, for `info`.
+/// CAD file's units, unsupported entities, faces left out), one line each, for `info`.
 pub fn load_scene_noted(
     path: &Path,
     options: LoadOptions,
@@ -223,8 +216,8 @@ pub fn load_scene_noted(
             ));
         }
         (bare_scene(path, load_subdivision(path)?), Vec::new())
-    } else if InputKind::of(path) == Some(InputKind::Step) {
-        let read = scene::build_scene(path, step::read_step(path)?)?;
+    } else if let Some(model) = read_cad(path)? {
+        let read = scene::build_scene(path, model)?;
         (read.scene, read.notes)
     } else {
         (read_any_scene(path)?, Vec::new())
@@ -321,115 +314,18 @@ fn check_box_range(path: &Path, name: &str, when: &str, b: &DAabb) -> Result<(),
     Ok(())
 }
 
-/// Reads an IGES file into millimetres and prints what was not drawn as one warning line
-/// on stderr (and each surface that could not be converted), so nothing is dropped
-/// silently.
-fn read_iges_warning(path: &Path) -> Result<iges::Iges, LoadError> {
-    let read = iges::read_iges(path)?.into_millimetres();
-    let r = &read.report;
-    if read.surfaces.is_empty() {
-        return Err(nothing_renderable(path, r));
-    }
-    for w in &r.warnings {
-        eprintln!("warning: {}: {w}", path.display());
-    }
-    if let Some(line) = r.ignored_line() {
-        eprintln!("warning: {}: {line}", path.display());
-    }
-    for f in &r.failed {
-        eprintln!("warning: {}: surface not converted: {f}", path.display());
-    }
-    if r.projected > 0 {
-        eprintln!(
-            "warning: {}: {} trim curve(s) projected from model space, largest projection error {:e}",
-            path.display(),
-            r.projected,
-            r.max_projection_error
-        );
-    }
-    Ok(read)
-}
-
-/// The error for an IGES file none of whose entities became a surface: what it held that
-/// was not read, and why each surface failed (the first few), so that it never reads as an
-/// empty scene.
-fn nothing_renderable(path: &Path, r: &iges::Report) -> LoadError {
-    const SHOWN: usize = 5;
-    let mut why = vec!["nothing to render: no surface was read".to_string()];
-    why.extend(r.ignored_line());
-    if r.ignored.is_empty() && r.failed.is_empty() {
-        why.push("its entities are curves, points and structure only".into());
-    }
-    if !r.failed.is_empty() {
-        let more = r.failed.len().saturating_sub(SHOWN);
-        let mut failed = r.failed[..r.failed.len().min(SHOWN)].join("; ");
-        if more > 0 {
-            failed.push_str(&format!("; and {more} more"));
-        }
-        why.push(format!(
-            "{} surface(s) not converted: {failed}",
-            r.failed.len()
-        ));
-    }
-    LoadError::invalid(path, why.join("; "))
-}
-
-/// A bare IGES file as a scene: one object per colour (IGES 314 or the Directory Entry's
-/// predefined colour), each with its material, framed like any bare geometry.
-fn iges_scene(path: &Path) -> Result<Scene, LoadError> {
-    let read = read_iges_warning(path)?;
-    let stem = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let mut colours: Vec<Option<glam::DVec3>> = Vec::new();
-    let mut groups: Vec<Vec<crate::scene::model::Surface>> = Vec::new();
-    for d in read.surfaces {
-        let k = match colours.iter().position(|c| *c == d.colour) {
-            Some(k) => k,
-            None => {
-                colours.push(d.colour);
-                groups.push(Vec::new());
-                colours.len() - 1
-            }
-        };
-        groups[k].push(d.surface);
-    }
-    let mut materials = vec![Material::default_named("default")];
-    let objects = colours
-        .iter()
-        .zip(groups)
-        .enumerate()
-        .map(|(k, (colour, surfaces))| {
-            let material = match colour {
-                Some(rgb) => {
-                    let mut m = Material::default_named(&format!("iges_colour_{k}"));
-                    m.diffuse = rgb.as_vec3();
-                    materials.push(m);
-                    materials.len() - 1
-                }
-                None => 0,
-            };
-            Object {
-                name: if k == 0 {
-                    stem.clone()
-                } else {
-                    format!("{stem}#{k}")
-                },
-                material,
-                geometry: Geometry::Surfaces(surfaces),
-            }
-        })
-        .collect();
-    let mut scene = Scene::framing(objects);
-    scene.materials = materials;
-    Ok(scene)
+/// The front door's model of a CAD file (STEP, IGES); `None` for other kinds.
+fn read_cad(path: &Path) -> Result<Option<scene::CadModel>, LoadError> {
+    Ok(match InputKind::of(path) {
+        Some(InputKind::Step) => Some(step::read_step(path)?),
+        Some(InputKind::Iges) => Some(iges::read_cad(path)?),
+        _ => None,
+    })
 }
 
 fn read_any_scene(path: &Path) -> Result<Scene, LoadError> {
     match InputKind::of(path).ok_or_else(|| unknown_kind(path))? {
         InputKind::Ron => ron_format::read_scene(path),
-        InputKind::Iges => iges_scene(path),
         _ => Ok(bare_scene(path, load_geometry(path)?)),
     }
 }

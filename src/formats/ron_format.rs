@@ -538,6 +538,7 @@ fn build_scene(
         objects,
         unread_bounds: None,
         warnings,
+        unit: None,
     })
 }
 

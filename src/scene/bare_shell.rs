@@ -88,6 +88,7 @@ impl BareShell {
                 max: DVec3::from_array(shell.bounds[1]),
             }),
             warnings: Vec::new(),
+            unit: None,
         })
     }
 }

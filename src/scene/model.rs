@@ -465,6 +465,9 @@ pub struct Scene {
     /// What reading the scene's files left out or tolerated, one line each, for the
     /// command line to print (the library prints nothing).
     pub warnings: Vec<String>,
+    /// The length unit of the coordinates, when the file read declared one (a CAD file:
+    /// millimetres, and the unit it declared), in words, for writers to state.
+    pub unit: Option<String>,
 }
 
 /// Default recursion limit for reflection and refraction.
@@ -509,6 +512,7 @@ impl Scene {
             objects,
             unread_bounds: None,
             warnings: Vec::new(),
+            unit: None,
         };
         scene.frame_bare(up);
         scene

@@ -48,14 +48,38 @@ fn info_prints_units_and_ignored_entities() {
         "{out}"
     );
     assert!(
-        out.contains("ignored: 1 × entity 402 (associativity)"),
+        out.contains("unsupported entities: 402 (associativity) x1"),
         "{out}"
     );
     assert!(
-        stderr(&o).contains("ignored: 1 × entity 402"),
+        stderr(&o).contains("hammer.iges: unsupported entities: 402 (associativity) x1"),
         "{}",
         stderr(&o)
     );
+}
+
+#[test]
+fn import_states_the_unit_of_its_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    // The hammer has trim loops, which only RON keeps; Rhino's one surface has none.
+    for (input, name, comment) in [
+        (gismo("hammer.iges"), "hammer.ron", "//"),
+        (testdata("cad/pyocc_testfile.igs"), "rhino.obj", "#"),
+    ] {
+        let out = dir.path().join(name);
+        let o = run(&[
+            "import",
+            input.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = std::fs::read_to_string(&out).unwrap();
+        assert_eq!(
+            text.lines().next().unwrap(),
+            format!("{comment} lengths in millimetres (the IGES file declares MM, 1 mm)"),
+        );
+    }
 }
 
 #[test]
@@ -174,7 +198,10 @@ fn an_iges_file_without_surfaces_is_refused_saying_what_it_held() {
         let err = stderr(&o);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains("nothing to render"), "{err}");
-        assert!(err.contains("curves, points and structure only"), "{err}");
+        assert!(
+            err.contains("the IGES file holds 1 entities (by type: 110 x1)"),
+            "{err}"
+        );
     }
     assert!(!out.exists());
 }

@@ -532,14 +532,14 @@ fn unsupported_entities_are_counted_and_bad_surfaces_named() {
     bad.subordinate = 0;
     let read = read(&[offset, bad]);
     assert_eq!(
-        read.report.ignored_line().unwrap(),
-        "ignored: 1 × entity 140 (offset surface)"
+        read.report.skipped().into_iter().collect::<Vec<_>>(),
+        [("140 (offset surface)".to_string(), 1)]
     );
     assert_eq!(read.report.failed.len(), 1);
+    let f = &read.report.failed[0];
     assert!(
-        read.report.failed[0].starts_with("entity 120 (D 3): "),
-        "{:?}",
-        read.report.failed
+        f.entity == "D 3" && f.why.starts_with("entity 120: "),
+        "{f:?}"
     );
 }
 
@@ -852,7 +852,11 @@ fn closed_analytic_surfaces_draw_whole_and_unbounded_ones_are_named() {
     ]);
     assert_eq!(read.surfaces.len(), 2, "{:?}", read.report.failed);
     assert_eq!(read.report.failed.len(), 1);
-    assert!(read.report.failed[0].starts_with("entity 192 (D 9): "));
+    let f = &read.report.failed[0];
+    assert!(
+        f.entity == "D 9" && f.why.starts_with("entity 192: "),
+        "{f:?}"
+    );
     for (k, drawn) in read.surfaces.iter().enumerate() {
         let SurfaceGeometry::Nurbs(s) = &drawn.surface.geometry else {
             panic!()
@@ -1165,11 +1169,9 @@ fn subfigure_cycles_and_blow_ups_are_refused_by_name() {
     ]);
     assert!(cyclic.surfaces.is_empty());
     assert!(
-        cyclic
-            .report
-            .failed
-            .iter()
-            .all(|f| f.ends_with("the definition D 1 contains an instance of itself")),
+        cyclic.report.failed.iter().all(|f| f
+            .why
+            .ends_with("the definition D 1 contains an instance of itself")),
         "{:?}",
         cyclic.report.failed
     );
@@ -1196,11 +1198,9 @@ fn subfigure_cycles_and_blow_ups_are_refused_by_name() {
     ents.push(top);
     let blown = read(&ents);
     assert!(
-        blown
-            .report
-            .failed
-            .iter()
-            .any(|f| f.contains("more than 65536 entities drawn through instances")),
+        blown.report.failed.iter().any(|f| f
+            .why
+            .contains("more than 65536 entities drawn through instances")),
         "{:?}",
         blown.report.failed.len()
     );
@@ -1271,8 +1271,10 @@ fn angles_beyond_a_turn_are_named_not_clamped() {
     assert!(read.surfaces.is_empty());
     assert_eq!(read.report.failed.len(), 1);
     assert!(
-        read.report.failed[0]
-            .starts_with("entity 144 (D 13): the trim loops span 70 in the angle u"),
+        read.report.failed[0].entity == "D 13"
+            && read.report.failed[0]
+                .why
+                .starts_with("entity 144: the trim loops span 70 in the angle u"),
         "{:?}",
         read.report.failed
     );
@@ -1361,12 +1363,22 @@ fn inch_file_is_read_into_millimetres() {
     // Unit flag 1 (inches, §2.2.4.3.14): 25.4 mm each.
     let global = GLOBAL.replacen(",2,2HMM,", ",1,4HINCH,", 1);
     let text = write_iges_global(&global, &[surf]);
-    let read = parse_iges(Path::new("inch.igs"), &text)
-        .unwrap()
-        .into_millimetres();
+    let read = parse_iges(Path::new("inch.igs"), &text).unwrap();
     assert_eq!(read.report.unit.name, "INCH");
     assert!(read.report.lines()[0].starts_with("IGES units: INCH (25.4 mm)"));
-    let (s, _) = only(&read);
+    // Through the CAD front door, as every command reads the file.
+    let built =
+        patchtrace::formats::cad::scene::build_scene(Path::new("inch.igs"), read.into_model())
+            .unwrap();
+    assert_eq!(
+        built.scene.unit.as_deref(),
+        Some("lengths in millimetres (the IGES file declares INCH, 25.4 mm)")
+    );
+    let surfaces = built.scene.objects[0].geometry.surfaces();
+    assert_eq!(surfaces.len(), 1);
+    let SurfaceGeometry::Nurbs(s) = &surfaces[0].geometry else {
+        panic!("a NURBS surface")
+    };
     for (u, v) in grid() {
         close(s.eval(u, v), net_point(&n, u, v) * 25.4, 100.0, "inch net");
     }

@@ -27,6 +27,17 @@ pub struct DeclaredUnit {
     pub millimetres: f64,
 }
 
+impl DeclaredUnit {
+    /// The unit of a scene read from a `format` file in this unit, in words: millimetres,
+    /// and what the file declared.
+    pub fn in_words(&self, format: &str) -> String {
+        format!(
+            "lengths in millimetres (the {format} file declares {}, {} mm)",
+            self.name, self.millimetres
+        )
+    }
+}
+
 /// One renderable piece of a part: an exact surface or a triangle mesh the file gives as
 /// triangles (AP242 tessellated geometry).
 #[derive(Clone, Debug)]
@@ -317,6 +328,7 @@ pub fn build_scene(path: &Path, model: CadModel) -> Result<CadScene, LoadError> 
     let mut scene = Scene::framing(assembled.objects);
     scene.materials = assembled.materials;
     scene.warnings = model.warning_lines(path);
+    scene.unit = Some(model.unit.in_words(model.format));
     Ok(CadScene {
         notes: model.info_lines(),
         scene,

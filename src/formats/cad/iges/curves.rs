@@ -103,7 +103,16 @@ fn pieces_at(model: &Model, pointer: usize, depth: usize) -> Result<Vec<Piece>, 
                 return Err("a weight is not positive".into());
             }
             let (d0, d1) = crate::geom::nurbs::knots::domain(c.degree, &curve.knots);
-            let (t0, t1) = (c.range[0].max(d0), c.range[1].min(d1));
+            // §4.23 (126): V(0) and V(1) bound the curve's use. Solid Edge writes
+            // V(0) = V(1) = 0 on lines whose knots run over [-1, 0]: a range that holds
+            // no curve at all, where the knots say which curve is meant, as OpenCASCADE
+            // reads it (the edge spans the knot domain); a range that merely reaches
+            // beyond the knots is clamped to them.
+            let (t0, t1) = if c.range[0] == c.range[1] {
+                (d0, d1)
+            } else {
+                (c.range[0].max(d0), c.range[1].min(d1))
+            };
             if t0.partial_cmp(&t1) != Some(std::cmp::Ordering::Less) {
                 return Err(format!(
                     "the parameter range [{}, {}] is empty",

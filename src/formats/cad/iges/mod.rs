@@ -32,6 +32,7 @@ use self::directory::DirEntry;
 use self::entities::{Entity, Params};
 use self::records::{Tolerated, Value};
 use self::units::LengthUnit;
+use super::scene::{CadModel, DeclaredUnit, Failure, Occurrence, Part, Piece, Shape};
 use crate::formats::error::ParseError;
 use crate::scene::model::Surface;
 
@@ -115,8 +116,8 @@ pub struct Report {
     pub warnings: Vec<String>,
     /// Drawn entities of types that are not read, by type.
     pub ignored: BTreeMap<i32, usize>,
-    /// Surfaces that could not be converted, with their directory sequence number.
-    pub failed: Vec<String>,
+    /// Surfaces that could not be converted, named by directory sequence number (`D 45`).
+    pub failed: Vec<Failure>,
     /// Trim curves projected from model space, and the largest distance of a projected
     /// point from the surface.
     pub projected: usize,
@@ -124,7 +125,8 @@ pub struct Report {
 }
 
 impl Report {
-    /// The lines `info` prints.
+    /// The lines `info` prints about the file (what was skipped and failed is added by
+    /// the [CAD front door](crate::formats::cad::scene)).
     pub fn lines(&self) -> Vec<String> {
         let mut out = vec![format!(
             "IGES units: {} ({} mm), read in millimetres (model scale {}{})",
@@ -139,32 +141,20 @@ impl Report {
         )];
         if self.projected > 0 {
             out.push(format!(
-                "IGES trim curves projected from model space: {} (largest projection error {:e})",
-                self.projected, self.max_projection_error
+                "IGES trim curves projected from model space: {} (largest projection error {:e} mm)",
+                self.projected,
+                self.max_projection_error * self.unit.millimetres
             ));
         }
-        if let Some(w) = self.ignored_line() {
-            out.push(w);
-        }
-        out.extend(
-            self.failed
-                .iter()
-                .map(|f| format!("IGES surface not converted: {f}")),
-        );
         out
     }
 
-    /// One line naming every ignored entity type and its count, or `None`.
-    pub fn ignored_line(&self) -> Option<String> {
-        if self.ignored.is_empty() {
-            return None;
-        }
-        let parts: Vec<String> = self
-            .ignored
+    /// The entity types not read, each named, for the front door's count by type.
+    pub fn skipped(&self) -> BTreeMap<String, usize> {
+        self.ignored
             .iter()
-            .map(|(t, n)| format!("{n} × entity {t} ({})", entity_name(*t)))
-            .collect();
-        Some(format!("ignored: {}", parts.join(", ")))
+            .map(|(t, n)| (format!("{t} ({})", entity_name(*t)), *n))
+            .collect()
     }
 }
 
@@ -217,21 +207,62 @@ pub struct Drawn {
 pub struct Iges {
     pub surfaces: Vec<Drawn>,
     pub report: Report,
+    /// What the file holds, by entity type, for the error when nothing is renderable.
+    pub held: String,
+}
+
+/// The entity types of a file's directory and their counts, in a few words.
+fn held(entries: &[DirEntry]) -> String {
+    let mut types: BTreeMap<i32, usize> = BTreeMap::new();
+    for e in entries {
+        *types.entry(e.entity_type).or_default() += 1;
+    }
+    let listed: Vec<String> = types.iter().map(|(t, n)| format!("{t} x{n}")).collect();
+    format!(
+        "{} entities (by type: {})",
+        entries.len(),
+        if listed.is_empty() {
+            "none".to_string()
+        } else {
+            listed.join(", ")
+        }
+    )
 }
 
 impl Iges {
-    /// The surfaces scaled from the file's unit to millimetres, the convention of every
-    /// CAD format here (as OpenCASCADE reads IGES), and the projection error with them.
-    pub fn into_millimetres(mut self) -> Iges {
-        let k = self.report.unit.millimetres;
-        if k != 1.0 {
-            let m = DAffine3::from_scale(DVec3::splat(k));
-            for d in &mut self.surfaces {
-                d.surface.transform(&m);
-            }
-            self.report.max_projection_error *= k;
-        }
-        self
+    /// The front door's model of the file: one part, placed once, in the file's unit
+    /// (the front door scales it to millimetres, as OpenCASCADE reads IGES).
+    pub fn into_model(self) -> CadModel {
+        let r = self.report;
+        let mut model = CadModel::new(
+            "IGES",
+            "surface",
+            DeclaredUnit {
+                name: r.unit.name.clone(),
+                millimetres: r.unit.millimetres,
+            },
+        );
+        model.parts.push(Part {
+            name: "IGES".into(),
+            pieces: self
+                .surfaces
+                .into_iter()
+                .map(|d| Piece {
+                    shape: Shape::Surface(d.surface),
+                    colour: d.colour.map(|c| c.as_vec3()),
+                })
+                .collect(),
+        });
+        model.occurrences.push(Occurrence {
+            part: 0,
+            transform: DAffine3::IDENTITY,
+        });
+        model.notes = r.lines();
+        model.skipped = r.skipped();
+        model.held = self.held;
+        model.warnings = r.warnings;
+        model.failures = r.failed;
+        model
     }
 }
 
@@ -362,7 +393,11 @@ pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
             &mut surfaces,
         );
     }
-    Ok(Iges { surfaces, report })
+    Ok(Iges {
+        surfaces,
+        report,
+        held: held(&model.entries),
+    })
 }
 
 /// Entities drawn through the instances of one top-level 408 at most: definitions that
@@ -397,17 +432,17 @@ fn draw(
     out: &mut Vec<Drawn>,
 ) {
     let Ok((entry, entity)) = model.get(pointer) else {
-        report
-            .failed
-            .push(format!("D {pointer}: not a directory entry of this file"));
+        report.failed.push(Failure {
+            entity: format!("D {pointer}"),
+            why: "not a directory entry of this file".into(),
+        });
         return;
     };
     let colour = model.colour(entry);
     let fail = |report: &mut Report, why: String| {
-        report.failed.push(format!(
-            "entity {} (D {}): {why}",
-            entry.entity_type, entry.sequence
-        ))
+        report
+            .failed
+            .push(failure(entry.entity_type, entry.sequence, why))
     };
     let converted = match entity {
         Entity::Trimmed { .. } => trimmed::trimmed(model, pointer, report),
@@ -444,7 +479,7 @@ fn draw(
                                 colour: face_colour.or(colour),
                             });
                         }
-                        Err(why) => report.failed.push(format!("entity 510 (D {f}): {why}")),
+                        Err(why) => report.failed.push(failure(510, f, why)),
                     }
                 }
             }
@@ -516,9 +551,23 @@ fn draw(
     }
 }
 
+/// A surface that could not be converted: named by its directory sequence number, its
+/// entity type opening the reason.
+fn failure(entity_type: i32, sequence: usize, why: String) -> Failure {
+    Failure {
+        entity: format!("D {sequence}"),
+        why: format!("entity {entity_type}: {why}"),
+    }
+}
+
 /// Reads an IGES file from disk.
 pub fn read_iges(path: &Path) -> Result<Iges, crate::formats::LoadError> {
     // Hollerith strings may hold any 8-bit text; the geometry is ASCII.
     let bytes = std::fs::read(path).map_err(|e| crate::formats::LoadError::io(path, e))?;
     Ok(parse_iges(path, &String::from_utf8_lossy(&bytes))?)
+}
+
+/// Reads an IGES file for the [CAD front door](crate::formats::cad::scene).
+pub fn read_cad(path: &Path) -> Result<CadModel, crate::formats::LoadError> {
+    Ok(read_iges(path)?.into_model())
 }
