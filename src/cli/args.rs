@@ -177,7 +177,8 @@ pub struct ImportArgs {
     #[command(flatten)]
     pub mesh: MeshArgs,
     /// Output: .ron (scene, geometry inline, NURBS with their trim loops), .bpt
-    /// (non-rational patches) or .obj (free-form Bézier patches).
+    /// (non-rational untrimmed patches), .obj (free-form Bézier patches with trims) or .igs
+    /// (IGES 5.3 trimmed surfaces).
     #[arg(short, long)]
     pub output: PathBuf,
     /// No progress bars.
@@ -191,7 +192,8 @@ pub struct ConvertArgs {
     pub input: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
-    /// Output: .obj (free-form Bézier), .bpt (non-rational only) or .ron.
+    /// Output: .obj (free-form Bézier with trims), .igs (IGES 5.3: 128 under 144, mm,
+    /// colours), .bpt (non-rational, untrimmed) or .ron.
     #[arg(short, long)]
     pub output: PathBuf,
     /// Print the report as JSON.

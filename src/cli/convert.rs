@@ -5,13 +5,20 @@ use std::process::ExitCode;
 
 use crate::cli::args::ConvertArgs;
 use crate::cli::setup::load;
+use crate::formats::load::InputKind;
 use crate::formats::write::write_scene_as;
 use crate::scene::convert::convert_scene;
 
 pub fn run(args: ConvertArgs) -> anyhow::Result<ExitCode> {
     let scene = load(&args.input, &args.mesh, args.quiet)?;
     let (converted, report) = convert_scene(&scene);
-    write_scene_as(&args.output, &converted)?;
+    // RON keeps what it is given, so it gets the patches; the patch formats decompose each
+    // surface themselves and write its patches as one sheet with its trims once.
+    let keeps_surfaces = matches!(InputKind::of(&args.output), Some(InputKind::Ron));
+    write_scene_as(
+        &args.output,
+        if keeps_surfaces { &converted } else { &scene },
+    )?;
     let mut out = std::io::stdout().lock();
     if args.json {
         writeln!(out, "{}", serde_json::to_string_pretty(&report)?)?;

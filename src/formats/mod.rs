@@ -11,12 +11,15 @@
 //! - [`error`]: located parse errors and load errors.
 //! - [`text`]: the tokenizer the line-based text formats share.
 //! - [`source_key`]: the digest of a scene's input files that a BVH file is checked against.
+//! - [`sheet`]: a scene's surfaces as sheets of Bézier patches with their trims in the
+//!   patches' parameters, which the OBJ free-form and IGES ([`iges_writer`]) writers write.
 
 pub mod bpt;
 pub mod cad;
 pub mod cage;
 pub mod error;
 pub mod gltf_mesh;
+pub mod iges_writer;
 pub mod load;
 pub mod mesh;
 pub mod obj;
@@ -24,6 +27,7 @@ pub mod pbrt;
 pub mod rays;
 pub mod ron_format;
 pub mod ron_locate;
+pub mod sheet;
 pub mod source_key;
 pub mod stl;
 pub mod text;

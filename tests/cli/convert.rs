@@ -74,13 +74,10 @@ fn import_convert_write_read_gives_the_same_patches() {
             ron.to_str().unwrap(),
         ]);
         assert!(o.status.success(), "{name}: {}", stderr(&o));
-        // A trimmed scene goes to RON, which keeps its loops; the OBJ writer would drop
-        // them, so it refuses (checked below).
+        // A trimmed scene goes to OBJ, which keeps its loops as `curv2` trims; the .bpt
+        // writer would drop them, so it refuses (checked below).
         let trimmed = name == "bspline_multiknot.obj";
-        let obj = dir.path().join(format!(
-            "{name}.{}",
-            if trimmed { "out.ron" } else { "obj" }
-        ));
+        let obj = dir.path().join(format!("{name}.obj"));
         let o = run(&[
             "convert",
             ron.to_str().unwrap(),
@@ -89,7 +86,7 @@ fn import_convert_write_read_gives_the_same_patches() {
         ]);
         assert!(o.status.success(), "{name}: {}", stderr(&o));
         if trimmed {
-            let refused = dir.path().join("trimmed.obj");
+            let refused = dir.path().join("trimmed.bpt");
             let o = run(&[
                 "convert",
                 ron.to_str().unwrap(),
@@ -97,14 +94,18 @@ fn import_convert_write_read_gives_the_same_patches() {
                 refused.to_str().unwrap(),
             ]);
             assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-            assert!(stderr(&o).contains("write .ron instead"), "{}", stderr(&o));
+            assert!(
+                stderr(&o).contains("write .obj, .igs or .ron instead"),
+                "{}",
+                stderr(&o)
+            );
             assert!(!refused.exists());
         }
         // Decomposition straight from the source file, independent of the RON and OBJ
         // round trip.
         let direct = patches_of(&testdata(name));
         let scene = patchtrace::formats::load_scene(&obj).unwrap();
-        // RON keeps each Bézier patch's loops and domain.
+        // OBJ keeps each Bézier patch's loops and domain.
         assert_eq!(scene.trim_loop_count() > 0, trimmed, "{name}");
         let back: Vec<BezierPatch> = scene
             .objects

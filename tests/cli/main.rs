@@ -11,6 +11,7 @@ mod bench_lg90;
 mod cad_occ;
 mod compare;
 mod convert;
+mod convert_trims;
 mod diff_cli;
 mod errors;
 mod examples;

@@ -13,11 +13,14 @@
 //!   wholly inside ones become trim-free at load.
 //! - [`axis_map`]: the map from a NURBS parameter to the (angle) parameter CAD files write
 //!   trims of analytic surfaces in.
+//! - [`reparam`]: loops moved from that parameter to the NURBS one, for the writers of
+//!   formats that have no such map.
 
 pub mod axis_map;
 pub mod crossing;
 pub mod pieces;
 pub mod region;
+pub mod reparam;
 
 pub use axis_map::AxisMap;
 pub use region::{Coverage, PatchTrim, TrimError, TrimRegion};
