@@ -114,6 +114,10 @@ pub fn split_net<T: KernelFloat>(
     }
 }
 
+fn distance2<T: KernelFloat>(a: [T; 3], b: [T; 3]) -> T {
+    (0..3).fold(T::ZERO, |acc, c| acc + (a[c] - b[c]) * (a[c] - b[c]))
+}
+
 /// The nets of a general-path search in the slots of a scratch buffer.
 pub struct GeneralStack<'a, T> {
     pub nets: &'a mut [[T; 4]],
@@ -154,13 +158,28 @@ impl<'a, T: KernelFloat> GeneralStack<'a, T> {
 }
 
 impl<T: KernelFloat> NetStack<T> for GeneralStack<'_, T> {
+    /// Along each boundary edge from b(0,0), the farther of the edge's middle and last
+    /// control points: a boundary that closes on itself (a full circle as one polynomial
+    /// patch, as IGES and STEP writers store periodic surfaces) has its last point on its
+    /// first, and measured by the corners alone the heuristic would never split across it,
+    /// halving the other direction until the split budget ran out with boxes as wide as
+    /// the circle (Dammertz's corner heuristic, §2.3.2, assumes open edges).
     fn corners(&self) -> Corners<T> {
         let net = self.slot(self.top);
         let s = self.shape;
+        let p00 = self.euclidean(net[0]);
+        let farther = |mid: usize, end: usize| {
+            let (m, e) = (self.euclidean(net[mid]), self.euclidean(net[end]));
+            if distance2(m, p00) > distance2(e, p00) {
+                m
+            } else {
+                e
+            }
+        };
         Corners {
-            p00: self.euclidean(net[0]),
-            pn0: self.euclidean(net[s.nu - 1]),
-            p0m: self.euclidean(net[(s.nv - 1) * s.nu]),
+            p00,
+            pn0: farther(s.nu / 2, s.nu - 1),
+            p0m: farther(s.nv / 2 * s.nu, (s.nv - 1) * s.nu),
         }
     }
 
@@ -269,6 +288,76 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Bernstein sum of a curve in the xz-plane, in `f64`.
+    fn bezier_xz(points: &[(f64, f64)], u: f64) -> (f64, f64) {
+        let n = points.len() - 1;
+        let binomial = |k: usize| (0..k).fold(1.0, |c, i| c * (n - i) as f64 / (i + 1) as f64);
+        points
+            .iter()
+            .enumerate()
+            .fold((0.0, 0.0), |(x, z), (k, p)| {
+                let b = binomial(k) * u.powi(k as i32) * (1.0 - u).powi((n - k) as i32);
+                (x + b * p.0, z + b * p.1)
+            })
+    }
+
+    #[test]
+    fn patch_whose_rows_close_on_themselves_is_split_across_them() {
+        // A closed degree-6 curve (first point = last) swept along y: every row of the net
+        // closes, so the corners of a u edge coincide. The hit must be the nearest
+        // crossing of the curve, found here by bisection on the Bernstein sum, within the
+        // normal split count (no budget reached, no box as wide as the curve reported).
+        let mut curve: Vec<(f64, f64)> = (0..6)
+            .map(|k| {
+                let a = k as f64 * std::f64::consts::FRAC_PI_3;
+                (2.0 * a.cos(), 2.0 * a.sin())
+            })
+            .collect();
+        curve.push(curve[0]);
+        let pts: Vec<DVec3> = [0.0, 1.0]
+            .iter()
+            .flat_map(|&y| curve.iter().map(move |&(x, z)| DVec3::new(x, y, z)))
+            .collect();
+        let patch = crate::kernel::subdivision::PreparedPatch::new(
+            &BezierPatch::from_points(6, 1, &pts).unwrap(),
+        );
+        let z0 = 0.3;
+        let crossings: Vec<f64> = (0..1000)
+            .filter_map(|k| {
+                let (mut a, mut b) = (k as f64 / 1000.0, (k + 1) as f64 / 1000.0);
+                let f = |u| bezier_xz(&curve, u).1 - z0;
+                if f(a) * f(b) > 0.0 {
+                    return None;
+                }
+                for _ in 0..60 {
+                    let m = 0.5 * (a + b);
+                    if f(a) * f(m) <= 0.0 { b = m } else { a = m }
+                }
+                Some(bezier_xz(&curve, a).0)
+            })
+            .collect();
+        let nearest_x = crossings.iter().cloned().fold(f64::INFINITY, f64::min);
+        let ray = crate::geom::Ray::new(
+            glam::Vec3::new(-10.0, 0.5, z0 as f32),
+            glam::Vec3::new(1.0, 0.0, 0.0),
+        );
+        let mut stats = crate::kernel::KernelStats::default();
+        let cfg = crate::kernel::subdivision::SubdivisionConfig::default();
+        let hit = crate::kernel::subdivision::intersect(&patch, None, &ray, &cfg, &mut stats)
+            .expect("the ray crosses the closed curve");
+        let want_t = nearest_x + 10.0;
+        assert!(
+            (hit.t as f64 - want_t).abs() < 1e-5 * want_t,
+            "t {} against {want_t}",
+            hit.t
+        );
+        assert!(
+            stats.splits < 1000,
+            "{} splits: the closed direction was not split",
+            stats.splits
+        );
     }
 
     #[test]
