@@ -180,24 +180,6 @@ fn colour_entry(c: Vec3) -> Entry {
     }
 }
 
-/// The clamped knot vector of a piecewise Bézier form: end breakpoints `degree + 1`
-/// times, interior ones `degree` times.
-fn bezier_knots(breaks: &[f64], degree: usize) -> Vec<f64> {
-    let last = breaks.len() - 1;
-    breaks
-        .iter()
-        .enumerate()
-        .flat_map(|(i, &b)| {
-            let repeat = if i == 0 || i == last {
-                degree + 1
-            } else {
-                degree
-            };
-            std::iter::repeat_n(b, repeat)
-        })
-        .collect()
-}
-
 /// 128 (§4.25): K1, K2, M1, M2, PROP1–5, knots in u then v, weights and points (u
 /// fastest), and the parameter range.
 fn surface_entry(sheet: &Sheet, colour: i64, trimmed: bool) -> Entry {
@@ -218,8 +200,14 @@ fn surface_entry(sheet: &Sheet, colour: i64, trimmed: bool) -> Entry {
     .map(Param::Int)
     .collect();
     let reals = |v: Vec<f64>| v.into_iter().map(Param::Real);
-    params.extend(reals(bezier_knots(&sheet.breaks_u, sheet.degree_u)));
-    params.extend(reals(bezier_knots(&sheet.breaks_v, sheet.degree_v)));
+    params.extend(reals(crate::geom::nurbs::knots::bezier_knots(
+        &sheet.breaks_u,
+        sheet.degree_u,
+    )));
+    params.extend(reals(crate::geom::nurbs::knots::bezier_knots(
+        &sheet.breaks_v,
+        sheet.degree_v,
+    )));
     params.extend(sheet.net.iter().map(|h| Param::Real(h.w)));
     for h in &sheet.net {
         let e = h.truncate() / h.w;

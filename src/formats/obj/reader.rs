@@ -430,7 +430,7 @@ impl<'a> Reader<'a, '_> {
                         ),
                     ));
                 }
-                bezier_knots(&breaks, degree)
+                crate::geom::nurbs::knots::bezier_knots(&breaks, degree)
             }
         };
         Ok(ParamCurve {
@@ -648,24 +648,6 @@ fn restricted_patch(patch: BezierPatch, range: ParamRect) -> Option<BezierPatch>
         .to_bezier_patches()
         .into_iter()
         .next()
-}
-
-/// The clamped knot vector of a piecewise Bézier curve with the given breakpoints: the
-/// end breakpoints repeated `degree + 1` times, interior ones `degree` times.
-fn bezier_knots(breaks: &[f64], degree: usize) -> Vec<f64> {
-    let last = breaks.len() - 1;
-    breaks
-        .iter()
-        .enumerate()
-        .flat_map(|(i, &b)| {
-            let repeat = if i == 0 || i == last {
-                degree + 1
-            } else {
-                degree
-            };
-            std::iter::repeat_n(b, repeat)
-        })
-        .collect()
 }
 
 /// `v x y z [w]` or `vp u [v [w]]`: the coordinates named in `names`, the first

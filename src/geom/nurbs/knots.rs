@@ -149,6 +149,24 @@ pub fn is_clamped(degree: usize, knots: &[f64]) -> bool {
     knots[0] == start && knots[knots.len() - 1] == end
 }
 
+/// The clamped knot vector of a piecewise Bézier curve with the given breakpoints: the
+/// end breakpoints repeated `degree + 1` times, interior ones `degree` times.
+pub fn bezier_knots(breaks: &[f64], degree: usize) -> Vec<f64> {
+    let last = breaks.len() - 1;
+    breaks
+        .iter()
+        .enumerate()
+        .flat_map(|(i, &b)| {
+            let repeat = if i == 0 || i == last {
+                degree + 1
+            } else {
+                degree
+            };
+            std::iter::repeat_n(b, repeat)
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
