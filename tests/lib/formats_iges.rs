@@ -359,6 +359,67 @@ fn surface_of_revolution_of_a_line_and_of_an_arc() {
     }
 }
 
+/// §4.41 (140): S(t, θ) + d N, N the unit normal S_t × S_θ of the base 120 (a cone
+/// frustum about z), computed here from the derivatives of the rotated line.
+#[test]
+fn offset_of_a_surface_of_revolution_of_a_line() {
+    let (l0, l1) = (DVec3::new(1.0, 0.0, 0.0), DVec3::new(2.0, 0.0, 2.0));
+    let (axis_0, axis_1) = (DVec3::new(0.0, 0.0, -1.0), DVec3::new(0.0, 0.0, 4.0));
+    let d = 0.25;
+    let mut offset = ent(140, &[0.0, 0.0, 0.0, d, de(3)]);
+    offset.subordinate = 0;
+    let read_offset = read(&[
+        ent(
+            110,
+            &[axis_0.x, axis_0.y, axis_0.z, axis_1.x, axis_1.y, axis_1.z],
+        ),
+        ent(110, &[l0.x, l0.y, l0.z, l1.x, l1.y, l1.z]),
+        offset,
+        ent(120, &[de(0), de(1), 0.0, 1.5 * PI]),
+    ]);
+    assert!(
+        read_offset.report.failed.is_empty(),
+        "{:?}",
+        read_offset.report.failed
+    );
+    let (s, surface) = only(&read_offset);
+    for (u, v) in grid() {
+        let (u, v) = s.domain().to_parent(u, v);
+        let (t, theta) = (
+            surface.trim_space[0].apply(u),
+            surface.trim_space[1].apply(v),
+        );
+        let p = rotate(l0.lerp(l1, t), DVec3::ZERO, DVec3::Z, theta);
+        let along = rotate(l1 - l0, DVec3::ZERO, DVec3::Z, theta);
+        let around = DVec3::Z.cross(p);
+        let want = p + d * along.cross(around).normalize();
+        close(s.eval(u, v), want, 4.0, "140 over 120");
+    }
+    // A line skew to the axis sweeps a hyperboloid, whose offset is no NURBS: refused,
+    // and the refusal says so.
+    let mut skew = ent(140, &[0.0, 0.0, 0.0, d, de(3)]);
+    skew.subordinate = 0;
+    let refused = read(&[
+        ent(
+            110,
+            &[axis_0.x, axis_0.y, axis_0.z, axis_1.x, axis_1.y, axis_1.z],
+        ),
+        ent(110, &[1.0, 0.0, 0.0, 1.0, 1.0, 2.0]),
+        skew,
+        ent(120, &[de(0), de(1), 0.0, PI]),
+    ]);
+    let why: Vec<String> = refused
+        .report
+        .failed
+        .iter()
+        .map(|f| f.why.clone())
+        .collect();
+    assert!(
+        why.len() == 1 && why[0].starts_with("entity 140: an offset"),
+        "{why:?}"
+    );
+}
+
 #[test]
 fn tabulated_cylinder_of_a_b_spline_and_its_trims() {
     let pts = [
@@ -526,14 +587,14 @@ fn parametric_spline_and_ellipse_as_trims_and_a_projected_model_space_curve() {
 
 #[test]
 fn unsupported_entities_are_counted_and_bad_surfaces_named() {
-    let mut offset = ent(140, &[0.0]);
-    offset.subordinate = 0;
+    let mut offset_curve = ent(130, &[0.0]);
+    offset_curve.subordinate = 0;
     let mut bad = ent(120, &[de(0), de(0), 0.0, 1.0]);
     bad.subordinate = 0;
-    let read = read(&[offset, bad]);
+    let read = read(&[offset_curve, bad]);
     assert_eq!(
         read.report.skipped().into_iter().collect::<Vec<_>>(),
-        [("140 (offset surface)".to_string(), 1)]
+        [("130 (offset curve)".to_string(), 1)]
     );
     assert_eq!(read.report.failed.len(), 1);
     let f = &read.report.failed[0];

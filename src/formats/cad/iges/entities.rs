@@ -243,6 +243,8 @@ pub enum Entity {
         generatrix: usize,
         angles: [f64; 2],
     },
+    /// 140: the surface `base` moved by `distance` along its unit normal.
+    Offset { base: usize, distance: f64 },
     /// 122: tabulated cylinder of `directrix` to the generatrix end point.
     Tabulated { directrix: usize, end: DVec3 },
     /// 114: parametric spline surface.
@@ -334,6 +336,7 @@ pub fn is_supported(entity_type: i32) -> bool {
             | 124
             | 126
             | 128
+            | 140
             | 141
             | 142
             | 143
@@ -464,6 +467,12 @@ pub fn read(p: &Params<'_>) -> Result<Entity, ParseError> {
             axis: p.pointer(1)?,
             generatrix: p.pointer(2)?,
             angles: [p.real(3)?, p.real(4)?],
+        },
+        // Parameters 1-3 are the offset indicator, a normal at one point that the
+        // distance's sign already fixes; OpenCASCADE reads only D and the surface too.
+        140 => Entity::Offset {
+            distance: p.real(4)?,
+            base: p.pointer(5)?,
         },
         122 => Entity::Tabulated {
             directrix: p.pointer(1)?,

@@ -453,6 +453,7 @@ fn draw(
         | Entity::Plane { .. }
         | Entity::Ruled { .. }
         | Entity::Revolution { .. }
+        | Entity::Offset { .. }
         | Entity::Tabulated { .. } => trimmed::untrimmed(model, pointer, report),
         Entity::Brep { shells } => {
             // §4.2 (186): every face of the outer and void shells, each its own trimmed

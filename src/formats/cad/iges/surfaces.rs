@@ -4,7 +4,7 @@
 //! surface, 120 surface of revolution, 122 tabulated cylinder. Planes (108) have no parameterisation and are built around
 //! their boundaries in `trimmed`.
 
-use glam::DVec4;
+use glam::{DVec3, DVec4};
 
 use super::Model;
 use super::curves::{self, Piece};
@@ -95,24 +95,29 @@ pub fn surface(model: &Model, pointer: usize) -> Result<Converted, String> {
             axis,
             generatrix,
             angles,
-        } => {
-            // §4.18: S(t, θ), t the generatrix's parameter, θ from the start to the end
-            // angle: the transpose of `analytic::revolution`, which puts the angle first.
-            let Entity::Line { start, end } = model.get(*axis)?.1 else {
-                return Err(format!("the axis D {axis} is not a line (110)"));
-            };
-            let m = model.transform(model.get(*axis)?.0.transform)?;
-            let (p0, p1) = (m.transform_point3(*start), m.transform_point3(*end));
-            let g = single(curves::pieces(model, *generatrix)?)?;
-            let (s, [angle, _]) =
-                analytic::revolution(&g.curve, p0, p1 - p0, angles[0], angles[1]).map_err(err)?;
-            Converted {
-                surface: s.transposed(),
-                maps: [g.map, angle],
-                range: None,
-                to_trim: SAME,
+        } => revolution(model, *axis, *generatrix, *angles, 0.0)?,
+        Entity::Offset { base, distance } => match model.get(*base)?.1 {
+            Entity::Revolution {
+                axis,
+                generatrix,
+                angles,
+            } => {
+                // The offset of a surface of revolution whose generatrix is a line in a
+                // plane of the axis is the revolution of that line moved along its normal
+                // (the normal is the same all along it): exact, and in the base's own
+                // parameters, so the trims of the base apply unchanged.
+                let mut c = revolution(model, *axis, *generatrix, *angles, *distance)?;
+                c.surface
+                    .transform(&model.transform(model.get(*base)?.0.transform)?);
+                c
             }
-        }
+            _ => {
+                return Err(format!(
+                    "the offset surface's base D {base} is entity {}; offsets are read of surfaces of revolution of lines, exactly",
+                    model.get(*base)?.0.entity_type
+                ));
+            }
+        },
         Entity::Tabulated { directrix, end } => {
             // §4.19: S(u, v) = C(t) + v (L − C(t0)), t = t0 + u (t1 − t0), u, v in [0, 1].
             // The NURBS u is the directrix's own parameter, so trims map to t.
@@ -195,6 +200,66 @@ fn bicubic(s: &SplineSurface) -> Result<NurbsSurface, String> {
         k
     };
     NurbsSurface::new(3, 3, knots(&s.u), knots(&s.v), count_u, count_v, points).map_err(err)
+}
+
+/// §4.18 (120): S(t, θ), t the generatrix's parameter, θ from the start to the end angle:
+/// the transpose of `analytic::revolution`, which puts the angle first. With `offset`
+/// non-zero, the 140 offset surface of it (S + offset · n, n the unit normal of
+/// S_t × S_θ), which is exact only for a line generatrix coplanar with the axis and not
+/// crossing it: other generatrices are refused.
+fn revolution(
+    model: &Model,
+    axis: usize,
+    generatrix: usize,
+    angles: [f64; 2],
+    offset: f64,
+) -> Result<Converted, String> {
+    let Entity::Line { start, end } = model.get(axis)?.1 else {
+        return Err(format!("the axis D {axis} is not a line (110)"));
+    };
+    let m = model.transform(model.get(axis)?.0.transform)?;
+    let (p0, p1) = (m.transform_point3(*start), m.transform_point3(*end));
+    let mut g = single(curves::pieces(model, generatrix)?)?;
+    if offset != 0.0 {
+        let shift = offset * line_normal(&g.curve, p0, p1 - p0)?;
+        for q in &mut g.curve.points {
+            *q += (shift * q.w).extend(0.0);
+        }
+    }
+    let (s, [angle, _]) =
+        analytic::revolution(&g.curve, p0, p1 - p0, angles[0], angles[1]).map_err(err)?;
+    Ok(Converted {
+        surface: s.transposed(),
+        maps: [g.map, angle],
+        range: None,
+        to_trim: SAME,
+    })
+}
+
+/// Relative size of a cross or triple product below which points count as on one line or
+/// one plane: some thousands of `f64` ulps, the rounding of the file's 10-digit reals
+/// and of a transform, far below any deliberate bend.
+const FLAT: f64 = 1e-12;
+
+/// The unit normal S_t × S_θ of the surface of revolution of the line `curve` about the
+/// axis through `p` along `a`, at θ = 0 (the generatrix's own position): S_t is the line's
+/// direction, S_θ = a × (G − p). It is one vector along the whole line when the line lies
+/// in a plane of the axis on one side of it; anything else has no exact offset here.
+fn line_normal(curve: &NurbsCurve, p: DVec3, a: DVec3) -> Result<DVec3, String> {
+    let (d0, d1) = (curve.knots[0], curve.knots[curve.knots.len() - 1]);
+    let (g0, g1) = (curve.eval(d0), curve.eval(d1));
+    let along = g1 - g0;
+    let straight = curve
+        .points
+        .iter()
+        .all(|q| (q.truncate() / q.w - g0).cross(along).length() <= FLAT * along.length_squared());
+    let (n0, n1) = (along.cross(a.cross(g0 - p)), along.cross(a.cross(g1 - p)));
+    let coplanar = along.dot(a.cross(g0 - p)).abs()
+        <= FLAT * along.length() * a.length() * (g0 - p).length().max(along.length());
+    if !straight || !coplanar || n0.dot(n1) <= 0.0 {
+        return Err("an offset of a surface of revolution is read only for a line generatrix in a plane of the axis, on one side of it (other offsets have no exact NURBS form)".into());
+    }
+    Ok(n0.normalize())
 }
 
 /// The one piece of a curve that must be a single NURBS curve (a generatrix, directrix or
