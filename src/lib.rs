@@ -1,8 +1,9 @@
 //! patchtrace: ray tracing Bézier patches and NURBS surfaces directly, to the precision of
 //! `f32` itself, without tessellating them first.
 //!
-//! Data flows one way: parse ([`scene`]) → scene model → (NURBS conversion, [`geom::nurbs`])
-//! → accelerator ([`accel`]) → kernels ([`kernel`]) → integrator and film ([`render`]).
+//! Data flows one way: readers ([`formats`]) → scene model ([`scene`]) → (NURBS
+//! conversion, [`geom::nurbs`]) → accelerator ([`accel`]) → kernels ([`kernel`]) →
+//! integrator and film ([`render`]).
 //! The command-line front end lives in [`cli`].
 
 // Numeric kernels index control nets by (i, j) in lockstep across several arrays; index

@@ -11,6 +11,9 @@
 //! - [`error`]: located parse errors and load errors.
 //! - [`text`]: the tokenizer the line-based text formats share.
 //! - [`source_key`]: the digest of a scene's input files that a BVH file is checked against.
+//! - [`ron_locate`]: where keys and variants are in a RON scene's text, for errors found
+//!   after deserialising.
+//! - [`write`](mod@write): writing a scene by the output's extension.
 //! - [`sheet`]: a scene's surfaces as sheets of Bézier patches with their trims in the
 //!   patches' parameters, which the OBJ free-form and IGES ([`iges_writer`]) writers write.
 

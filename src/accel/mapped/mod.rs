@@ -19,7 +19,7 @@
 //! Then the scene section, the scene file's parse for `render --bvh` to skip the RON parse
 //! when the text is unchanged: the xxh3-64 of the scene file's bytes (`u64`; for a bare
 //! geometry file the key of its inputs), the length `u64` of the JSON that follows
-//! (`ron_format::SceneFile`, or for a bare geometry file its scene without geometry,
+//! (`formats::ron_format::SceneFile`, or for a bare geometry file its scene without geometry,
 //! `scene::bare_shell::BareShell`), the JSON, and the [`checksum`] of the section.
 //!
 //! The tree and the records are built in the scene moved by minus the floating origin
@@ -288,7 +288,7 @@ pub fn map(path: &Path) -> Result<Opened, LoadError> {
 
 impl Opened {
     /// The scene's parse the file keeps: the xxh3-64 of the scene file's bytes and the
-    /// JSON of its serde mirror (`scene::ron_format::ParsedScene`), or for a bare geometry
+    /// JSON of its serde mirror (`formats::ron_format::SceneFile`), or for a bare geometry
     /// file the key of its inputs and its scene's `scene::bare_shell::BareShell`; empty
     /// when none.
     pub fn cached_scene(&self) -> (u64, &[u8]) {

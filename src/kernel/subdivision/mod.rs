@@ -5,7 +5,11 @@
 //!
 //! - [`search`]: the stack-based search, once for every net storage and precision.
 //! - [`bicubic`], [`bilinear`]: the SIMD fast paths for bicubic and bilinear integral
-//!   patches, on the shared [`register`] net stack.
+//!   patches, on the shared [`register`] net stack; [`avx512`]: the bicubic path with the
+//!   whole net in four AVX-512 registers.
+//! - [`ray_space`], [`jump`]: the net transformed into a frame where the ray is the
+//!   z-axis, and Newton jumps there past levels a linearisation already decides.
+//! - [`prepared`]: the per-patch data of the `f32` kernel, built once per patch.
 //! - [`general`]: any degree up to 15, rational patches (homogeneous nets, §2.7.2).
 //! - [`reference`]: the same algorithm in `f64`, the accuracy reference (§2.3.4).
 //! - [`heuristics`], [`config`], [`param`], [`float`]: split direction, settings,

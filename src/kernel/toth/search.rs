@@ -198,7 +198,7 @@ pub fn examine(
     // only run where the box reaches back before `tmin` (nothing else can be trivial), and
     // test 2 only on safe regions: on undecided boxes its extra sub-net cost more than it
     // saved, since the halves of a box it would drop fail the ray–box test next anyway
-    // (measured on the half-pipe of tests/lg6_trivial.rs: 224 sub-nets, 5 boxes dropped,
+    // (measured on the half-pipe of tests/lib/lg6_trivial.rs: 224 sub-nets, 5 boxes dropped,
     // no search iteration saved).
     let isrt = goal == Goal::Any && cfg.isrt;
     let trivial_here = pr.origin && rb.t.lo() < pr.tmin;

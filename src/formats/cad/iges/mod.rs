@@ -9,9 +9,8 @@
 //! trimmed surfaces (144), bounded surfaces (143), the faces of manifold solids (186, its
 //! 514 shells, 510 faces, 508 loops and 504 edge lists), bare surfaces (128, 114, 108,
 //! 118, 120, 122, and the closed analytic 196, 198), and subfigure instances (408 of a
-//! 308), flattened into transformed copies of their members while the scene model has no
-//! shared instances. What is not read
-//! is counted by type in [`Report`]; a surface that cannot be converted is named by its
+//! 308), flattened into transformed copies of their members. What is not read is counted
+//! by type in [`Report`]; a surface that cannot be converted is named by its
 //! directory sequence number; neither is dropped silently.
 
 pub mod curves;
@@ -492,8 +491,8 @@ fn draw(
             scale,
         } => {
             // §4.137 (408): the definition scaled by S, translated by (X, Y, Z), then
-            // mapped by the instance's own transform. The renderer has no shared
-            // instances yet, so each instance becomes transformed copies of the members.
+            // mapped by the instance's own transform. Each instance becomes transformed
+            // copies of the members (a STEP part used more than once is shared instead).
             if instancing.definitions.contains(definition) {
                 return fail(
                     report,
