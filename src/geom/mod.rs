@@ -14,6 +14,7 @@ pub mod nurbs;
 pub mod pcurve;
 pub mod ray;
 pub mod real;
+pub mod segment;
 pub mod subdiv;
 pub mod trim;
 pub mod ulp;

@@ -9,6 +9,7 @@ use glam::{DVec3, DVec4};
 
 use crate::geom::BezierPatch;
 use crate::geom::bezier::{de_casteljau_point, dehomogenize};
+use crate::geom::segment::distance_to_segment;
 
 /// The four sides of a patch's parameter square, counter-clockwise from (0, 0).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -153,15 +154,4 @@ pub fn segments_until(degree: usize, fine: &dyn Fn(f64, f64) -> bool) -> usize {
         n *= 2;
     }
     MAX_ADAPTIVE_SEGMENTS
-}
-
-pub fn distance_to_segment(p: DVec3, a: DVec3, b: DVec3) -> f64 {
-    let ab = b - a;
-    let len2 = ab.length_squared();
-    let t = if len2 > 0.0 {
-        ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + ab * t)).length()
 }

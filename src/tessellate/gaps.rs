@@ -11,7 +11,7 @@ use std::collections::HashMap;
 use glam::DVec3;
 use serde::Serialize;
 
-use super::edge::distance_to_segment;
+use crate::geom::segment::distance_to_segment;
 
 /// How near (as a fraction of the diagonal of all trimmed boundaries' box) another face's
 /// boundary must come for a sample to count as shared with it. CAD exchange tolerances are

@@ -354,7 +354,7 @@ mod tests {
         (0..poly.len())
             .map(|k| {
                 let (a, b) = (poly[k].extend(0.0), poly[(k + 1) % poly.len()].extend(0.0));
-                super::super::edge::distance_to_segment(p.extend(0.0), a, b)
+                crate::geom::segment::distance_to_segment(p.extend(0.0), a, b)
             })
             .fold(f64::INFINITY, f64::min)
     }

@@ -24,16 +24,13 @@ use glam::{DVec2, DVec3, DVec4};
 
 use super::entities::{Curve, Edge, Face, PCurve, SurfaceDef};
 use super::geometry::{curve_to_nurbs, surface_to_nurbs};
+use crate::formats::cad::CHORD_TOLERANCE;
 use crate::geom::nurbs::inversion::Inverter;
 use crate::geom::nurbs::{NurbsCurve, NurbsSurface};
 use crate::geom::pcurve::{self, ParamSurface, unwrap};
 use crate::geom::trim::{ParamCurve, TrimLoop, TrimSegment};
 use crate::scene::model::{Surface, SurfaceGeometry};
 
-/// Largest distance, relative to the model's size, between a projected edge and the
-/// surface image of the polyline that stands for it in the domain: 1e-5 of the model is
-/// well below a pixel of any framing view (a 4k image resolves 2.5e-4 of it).
-pub const CHORD_TOLERANCE: f64 = 1e-5;
 /// How far a pcurve may stray from its 3D curve, relative to the model's size, and still
 /// be used: CAD systems write edges to tolerances of about 1e-7 to 1e-4 of the part.
 const PCURVE_TOLERANCE: f64 = 1e-4;
