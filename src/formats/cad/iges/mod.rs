@@ -121,6 +121,10 @@ pub struct Report {
     /// point from the surface.
     pub projected: usize,
     pub max_projection_error: f64,
+    /// Surfaces (directory sequence numbers) whose parameter-space trim curves lay far
+    /// from their model-space curves, which were drawn instead, and the largest distance.
+    pub strayed: Vec<usize>,
+    pub max_stray: f64,
 }
 
 impl Report {
@@ -143,6 +147,13 @@ impl Report {
                 "IGES trim curves projected from model space: {} (largest projection error {:e} mm)",
                 self.projected,
                 self.max_projection_error * self.unit.millimetres
+            ));
+        }
+        if let Some(first) = self.strayed.first() {
+            out.push(format!(
+                "IGES trim curves drawn from model space because their parameter-space curves lie up to {:e} mm from them: on {} surface(s) (first D {first})",
+                self.max_stray * self.unit.millimetres,
+                self.strayed.len()
             ));
         }
         out
@@ -302,6 +313,8 @@ pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
         failed: Vec::new(),
         projected: 0,
         max_projection_error: 0.0,
+        strayed: Vec::new(),
+        max_stray: 0.0,
     };
     let entries = directory::entries(path, &sections.directory)?;
     let mut entities = Vec::with_capacity(entries.len());

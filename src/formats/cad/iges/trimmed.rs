@@ -1,10 +1,11 @@
 //! Trimmed surfaces (OpenCASCADE's `IGESToBRep_TopoSurface`): 144 (a surface, an optional
 //! outer boundary and holes, each a 142 curve on the surface), 143 (a surface and its 141
 //! boundaries, each a chain of model-space curves with their parameter-space curves), and
-//! bare surfaces. A parameter-space curve is used where it is given and not marked second
-//! choice; otherwise the model-space curve is projected into the domain (by point inversion
-//! on B-spline-like surfaces, reporting the largest distance; in closed form on the
-//! analytic 190–198). Planes (108, and 190 without parameterisation) have no
+//! bare surfaces. A parameter-space curve is used where it is given, not marked second
+//! choice and, laid on the surface, near its model-space curve; otherwise the model-space
+//! curve is projected into the domain (`geom::pcurve` on B-spline-like surfaces: refined to
+//! a chord tolerance, unwrapped across seams, through poles, reporting the largest
+//! distance; in closed form on the analytic 190–198). Planes (108, and 190 without parameterisation) have no
 //! parameterisation of their own: their patch is laid in a frame of the plane around the
 //! boundary curves, projected onto it exactly (an affine map of the control points).
 
@@ -15,9 +16,12 @@ use super::elementary::{self, Placed};
 use super::entities::{Elementary, Entity};
 use super::surfaces::{self, Converted};
 use super::{Model, Report};
+use crate::formats::cad::CHORD_TOLERANCE;
+use crate::geom::bezier::ParamRect;
 use crate::geom::nurbs::NurbsSurface;
 use crate::geom::nurbs::analytic::{self, Frame};
-use crate::geom::nurbs::inversion::Inverter;
+use crate::geom::pcurve::{self, NurbsTarget, ParamSurface};
+use crate::geom::segment::distance_to_segment;
 use crate::geom::trim::{AxisMap, ParamCurve, TrimLoop, TrimSegment};
 use crate::scene::model::{Surface, SurfaceGeometry};
 
@@ -265,37 +269,270 @@ fn with_loops(
         return analytic_with_loops(model, &placed, loops);
     }
     let c = surfaces::surface(model, pointer)?;
-    let mut inverter = None;
+    let mut target = None;
     let mut trims = Vec::new();
+    let mut stray = 0.0f64;
+    let far = STRAY * c.surface.net_diagonal();
     for l in loops {
-        let mut segments = Vec::new();
+        let mut parts = Vec::new();
         for e in &l.edges {
             if let Some(s) = parameter_segments(model, l.model_preferred, e, c.to_trim)? {
-                segments.extend(s);
-                continue;
-            }
-            let inv = inverter.get_or_insert_with(|| Inverter::new(&c.surface));
-            for piece in edge_pieces(model, e.model, e.reversed)? {
-                let mut points = Vec::new();
-                for q in samples(&piece) {
-                    let hit = inv
-                        .project(q)
-                        .ok_or("a model-space trim point could not be projected")?;
-                    report.max_projection_error = report.max_projection_error.max(hit.distance);
-                    points.push(DVec2::new(c.maps[0].apply(hit.u), c.maps[1].apply(hit.v)));
+                let off = if e.model == 0 {
+                    0.0
+                } else {
+                    stray_from_model(model, e, &c)?
+                };
+                if off <= far {
+                    parts.extend(s.into_iter().map(Part::Given));
+                    continue;
                 }
-                if points.len() >= 2 {
-                    segments.push(TrimSegment::polyline(&points));
+                stray = stray.max(off);
+            }
+            let target = target.get_or_insert_with(|| Target::new(&c.surface));
+            for piece in edge_pieces(model, e.model, e.reversed)? {
+                let projected = pcurve::project(
+                    &*target,
+                    |t| piece.curve.eval(t),
+                    piece.t0,
+                    piece.t1,
+                    target.tolerance,
+                )
+                .map_err(|p| format!("the model-space trim point {p} could not be projected"))?;
+                report.max_projection_error = report.max_projection_error.max(projected.error);
+                if projected.points.len() >= 2 {
+                    parts.push(Part::Projected(projected.points));
                 }
             }
             report.projected += 1;
         }
+        let segments = match &target {
+            Some(target) => target.join(parts, &c.maps),
+            None => parts
+                .into_iter()
+                .filter_map(|p| match p {
+                    Part::Given(s) => Some(s),
+                    Part::Projected(_) => None,
+                })
+                .collect(),
+        };
         trims.push(TrimLoop {
             hole: l.hole,
             segments,
         });
     }
+    if stray > 0.0 {
+        report.strayed.push(model.get(pointer)?.0.sequence);
+        report.max_stray = report.max_stray.max(stray);
+    }
     Ok(finish(c, trims))
+}
+
+/// A converted surface as the projection of model-space trim curves sees it: its NURBS
+/// parameters, periodic in each direction in which the surface closes (so that a loop
+/// crossing the seam stays continuous and one through a pole keeps its angle).
+struct Target<'s> {
+    nurbs: NurbsTarget<'s>,
+    domain: ParamRect,
+    periods: [Option<f64>; 2],
+    /// The projection's chord tolerance, `pcurve`'s refinement bound.
+    tolerance: f64,
+}
+
+impl<'s> Target<'s> {
+    fn new(surface: &'s NurbsSurface) -> Target<'s> {
+        let size = surface.net_diagonal();
+        let d = surface.domain();
+        let closed = [
+            surface.is_closed_u(CLOSED * size),
+            surface.transposed().is_closed_u(CLOSED * size),
+        ];
+        Target {
+            nurbs: NurbsTarget::new(surface),
+            domain: d,
+            periods: [
+                closed[0].then_some(d.u1 - d.u0),
+                closed[1].then_some(d.v1 - d.v0),
+            ],
+            tolerance: CHORD_TOLERANCE * size,
+        }
+    }
+
+    /// Axis `k`'s domain.
+    fn range(&self, k: usize) -> (f64, f64) {
+        let d = self.domain;
+        if k == 0 { (d.u0, d.u1) } else { (d.v0, d.v1) }
+    }
+
+    /// The trim parameters of NURBS parameters `uv` that may lie whole periods outside
+    /// the domain: mapped from within it, then moved by as many periods of the trim
+    /// parameter (the map's rise over the domain: a turn for an angle).
+    fn to_trim(&self, maps: &[AxisMap; 2], uv: DVec2) -> DVec2 {
+        let mut out = DVec2::ZERO;
+        for k in 0..2 {
+            let (a, b) = self.range(k);
+            out[k] = match self.periods[k] {
+                Some(p) => {
+                    let turns = ((uv[k] - a) / p).floor();
+                    maps[k].apply(uv[k] - turns * p) + turns * (maps[k].apply(b) - maps[k].apply(a))
+                }
+                None => maps[k].apply(uv[k]),
+            };
+        }
+        out
+    }
+}
+
+impl ParamSurface for Target<'_> {
+    fn point(&self, uv: DVec2) -> DVec3 {
+        let mut w = uv;
+        for k in 0..2 {
+            if let Some(p) = self.periods[k] {
+                let (a, _) = self.range(k);
+                w[k] = a + (w[k] - a).rem_euclid(p);
+            }
+        }
+        self.nurbs.point(w)
+    }
+
+    fn parameters(&self, p: DVec3) -> Option<DVec2> {
+        self.nurbs.parameters(p)
+    }
+
+    fn periods(&self) -> [Option<f64>; 2] {
+        self.periods
+    }
+}
+
+/// A piece of a trim loop: a parameter-space curve as the file gives it, or a model-space
+/// curve projected into the surface's NURBS parameters (each unwrapped along itself).
+enum Part {
+    Given(TrimSegment),
+    Projected(Vec<DVec2>),
+}
+
+impl Target<'_> {
+    /// The loop's pieces as trim segments. Projected curves follow on from the one before
+    /// by whole periods; where that one ends at a pole, the angle they follow on from
+    /// means nothing (the loop runs along the pole from one angle to another), so when a
+    /// loop of projected curves then fails to close by whole periods, the curves after the
+    /// last pole are moved back by them.
+    fn join(&self, parts: Vec<Part>, maps: &[AxisMap; 2]) -> Vec<TrimSegment> {
+        let mut parts = parts;
+        let mut last: Option<DVec2> = None;
+        let mut after_pole = [None; 2];
+        for (i, part) in parts.iter_mut().enumerate() {
+            let Part::Projected(points) = part else {
+                last = None;
+                continue;
+            };
+            if let Some(prev) = last {
+                for k in 0..2 {
+                    let shift =
+                        pcurve::unwrap(points[0][k], prev[k], self.periods[k]) - points[0][k];
+                    points.iter_mut().for_each(|p| p[k] += shift);
+                    if pcurve::collapsed(self, prev, k, self.tolerance) {
+                        after_pole[k] = Some(i);
+                    }
+                }
+            }
+            last = points.last().copied();
+        }
+        let all_projected = parts.iter().all(|p| matches!(p, Part::Projected(_)));
+        if let (true, Some(Part::Projected(first)), Some(Part::Projected(end))) =
+            (all_projected, parts.first(), parts.last())
+        {
+            let gap = end[end.len() - 1] - first[0];
+            for k in 0..2 {
+                let Some(p) = self.periods[k] else { continue };
+                if let Some(i) = after_pole[k] {
+                    let turns = (gap[k] / p).round();
+                    shift(&mut parts[i..], k, -turns * p);
+                }
+                // The whole loop by whole periods to start within the domain, where the
+                // surface is.
+                let lowest = parts
+                    .iter()
+                    .flat_map(|part| match part {
+                        Part::Projected(points) => points.as_slice(),
+                        Part::Given(_) => &[],
+                    })
+                    .fold(f64::INFINITY, |m, q| m.min(q[k]));
+                let (a, _) = self.range(k);
+                shift(&mut parts, k, -((lowest - a) / p + 1e-9).floor() * p);
+            }
+        }
+        parts
+            .into_iter()
+            .map(|p| match p {
+                Part::Given(s) => s,
+                Part::Projected(points) => {
+                    let trim: Vec<DVec2> =
+                        points.iter().map(|&uv| self.to_trim(maps, uv)).collect();
+                    TrimSegment::polyline(&trim)
+                }
+            })
+            .collect()
+    }
+}
+
+/// Moves the projected parts by `by` along axis `k`.
+fn shift(parts: &mut [Part], k: usize, by: f64) {
+    for part in parts {
+        if let Part::Projected(points) = part {
+            points.iter_mut().for_each(|q| q[k] += by);
+        }
+    }
+}
+
+/// A parameter-space trim curve laid on its surface may lie this far, as a fraction of
+/// the surface's size, from the model-space curve it stands for before the two are taken
+/// to disagree: far above any writer's rounding or fitting, far below a curve in another
+/// place.
+const STRAY: f64 = 1e-3;
+
+/// How far the parameter-space curves of an edge, laid on the surface, lie from its
+/// model-space curve: the largest distance of nine points per piece from the polyline
+/// through the model-space curve's samples. §4.22 (142) lets a writer give both curves
+/// for one boundary; when they disagree by far more than rounding, the parameter-space
+/// one follows a parameterisation this reader does not share (SolidWorks measures the
+/// parameter of a 100 arc generatrix of a 120 from the arc's start, not as §4.3's
+/// angle), and the model-space curve, which needs none, is the one to draw, as
+/// OpenCASCADE's reading of such files shows.
+fn stray_from_model(model: &Model, e: &Edge, c: &Converted) -> Result<f64, String> {
+    let polyline: Vec<DVec3> = edge_pieces(model, e.model, false)?
+        .iter()
+        .flat_map(samples)
+        .collect();
+    let d = c.surface.domain();
+    // The NURBS parameter of a trim parameter, brought into the domain (a closed
+    // surface's loops may run past its seam).
+    let into = |x: f64, (a, b): (f64, f64)| {
+        if x < a || x > b {
+            a + (x - a).rem_euclid(b - a)
+        } else {
+            x
+        }
+    };
+    let [(su, ou), (sv, ov)] = c.to_trim;
+    let mut largest = 0.0f64;
+    for &pc in &e.parameter {
+        for piece in curves::pieces(model, pc)? {
+            for k in 0..=8 {
+                let q = piece
+                    .curve
+                    .eval(piece.t0 + (piece.t1 - piece.t0) * k as f64 / 8.0);
+                let u = into(c.maps[0].invert(su * q.x + ou), (d.u0, d.u1));
+                let v = into(c.maps[1].invert(sv * q.y + ov), (d.v0, d.v1));
+                let p = c.surface.eval(u, v);
+                let nearest = polyline
+                    .windows(2)
+                    .map(|w| distance_to_segment(p, w[0], w[1]))
+                    .fold(f64::INFINITY, f64::min);
+                largest = largest.max(nearest);
+            }
+        }
+    }
+    Ok(largest)
 }
 
 fn err(e: impl std::fmt::Display) -> String {
