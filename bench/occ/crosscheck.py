@@ -63,6 +63,13 @@ def parse_args():
         help="IntCurvesFace_ShapeIntersector::Load tolerance (default 1e-7)",
     )
     p.add_argument(
+        "--occ-iges-curves",
+        choices=sorted(occ_model.IGES_CURVE_MODES),
+        default="file",
+        help="which trim curves OpenCASCADE reads from IGES 142/141 (read.surfacecurve.mode): "
+        "as each file prefers (default), or parameter-space (2d) or model-space (3d) forced",
+    )
+    p.add_argument(
         "--timeout", type=float, default=1800, help="seconds per file for each program (default 1800)"
     )
     p.add_argument(
@@ -146,6 +153,7 @@ def _child(send, check, path, folder, args):
     os.makedirs(folder, exist_ok=True)
     with occ_model.console_to(os.path.join(folder, "occ.log")):
         try:
+            occ_model.use_iges_curves(args.occ_iges_curves)
             row = check(path, folder, args)
         except Exception as e:  # a bug in the checker: the row says so, the run goes on
             traceback.print_exc()

@@ -19,7 +19,8 @@ from OCP.BRepAdaptor import BRepAdaptor_Surface
 from OCP.BRepBndLib import BRepBndLib
 from OCP.collections import IndexedMap_TopoDS_Shape_TopTools_ShapeMapHasher as ShapeMap
 from OCP.IFSelect import IFSelect_ReturnStatus
-from OCP.IGESControl import IGESControl_Reader
+from OCP.IGESControl import IGESControl_Controller, IGESControl_Reader
+from OCP.Interface import Interface_Static
 from OCP.STEPControl import STEPControl_Reader
 from OCP.TopAbs import TopAbs_FACE
 from OCP.TopExp import TopExp
@@ -60,6 +61,20 @@ class Model:
     def surface_type(self, number):
         kind = BRepAdaptor_Surface(self.faces[number - 1]).GetType()
         return kind.name.removeprefix("GeomAbs_")
+
+
+# IGES `read.surfacecurve.mode` values: which curve of a 142 curve on surface (or 141
+# boundary) OpenCASCADE builds a face's edges from.
+IGES_CURVE_MODES = {"file": 0, "2d": -2, "3d": -3}
+
+
+def use_iges_curves(mode):
+    """Makes OpenCASCADE's IGES reader take the trim curves each file prefers ("file"), or
+    force parameter-space ("2d") or model-space ("3d") ones: to check a file whose two
+    representations of a boundary disagree."""
+    IGESControl_Controller.Init_s()
+    if not Interface_Static.SetIVal_s("read.surfacecurve.mode", IGES_CURVE_MODES[mode]):
+        raise RuntimeError("OpenCASCADE has no read.surfacecurve.mode")
 
 
 def read_model(path):
