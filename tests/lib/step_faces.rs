@@ -434,9 +434,13 @@ fn a_band_around_an_extruded_closed_profile() {
 /// hole leaves it, both FACE_BOUND and used clockwise seen from outside (the face on
 /// their right: holes, ISO 10303-42 face_bound). The face is the sphere without the two
 /// caps |x| > c: checked at the points of the NURBS against that closed form.
-#[test]
-fn a_sphere_with_holes_only_is_the_sphere_without_them() {
-    let (r, c) = (1.0, 0.6_f64);
+/// The unit sphere about the origin (axis z, longitude 0 at +x) with a circular hole
+/// about each of `centres` (unit directions) at distance `c` from the centre, each bound
+/// a one-edge loop whose vertex is the circle's point towards `start` from its centre,
+/// as the face's only bounds; checked over a grid of the surface against the closed form
+/// (a point is cut away when its component along a centre exceeds c).
+fn check_sphere_with_holes(c: f64, holes: &[(DVec3, DVec3)], poles: bool) {
+    let r = 1.0;
     let rho = (r * r - c * c).sqrt();
     let mut w = StepWriter::default();
     let ax = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
@@ -445,17 +449,36 @@ fn a_sphere_with_holes_only_is_the_sphere_without_them() {
         step_support::real(r)
     ));
     let mut bounds = Vec::new();
-    for side in [1.0, -1.0] {
-        // Counter-clockwise about the outward axis ±x, used backwards: clockwise seen
+    for &(centre, start) in holes {
+        // Counter-clockwise about the outward axis, used backwards: clockwise seen
         // from outside.
-        let cax = w.axis(DVec3::X * c * side, DVec3::X * side, DVec3::Y);
+        let cax = w.axis(centre * c, centre, start);
         let circle = w.circle(cax, rho);
-        let vx = w.vertex(DVec3::X * c * side + DVec3::Y * rho);
+        let vx = w.vertex(centre * c + start * rho);
         let e = w.edge(vx, vx, circle, true);
         bounds.push(w.bound(&[(e, false)], false));
     }
+    if poles {
+        // A vertex loop at each pole, as Parasolid writes a sphere's degenerate ends.
+        for z in [1.0, -1.0] {
+            let v = w.vertex(DVec3::Z * z);
+            let vl = w.add(format!("VERTEX_LOOP('',#{v})"));
+            bounds.push(w.add(format!("FACE_BOUND('',#{vl},.T.)")));
+        }
+    }
     w.face(&bounds, s);
     let surface = only_surface(&read(&w.finish()));
+    assert_region(&surface, |p| {
+        let along: Vec<f64> = holes.iter().map(|(h, _)| p.dot(*h)).collect();
+        (!along.iter().any(|a| (a - c).abs() < 0.05)).then(|| along.iter().all(|&a| a < c))
+    });
+}
+
+/// Checks the face's trim region over a 39 × 39 grid inside its surface's domain (the
+/// domain's edges, where a closed surface's seam and the loops' closing lines run, left
+/// out) against `expect` (whether a surface point belongs to the face; `None` near a
+/// boundary, not checked).
+fn assert_region(surface: &Surface, expect: impl Fn(DVec3) -> Option<bool>) {
     let region = surface.trim_region().unwrap().expect("trimmed");
     let SurfaceGeometry::Nurbs(n) = &surface.geometry else {
         panic!("expected a NURBS surface")
@@ -463,16 +486,14 @@ fn a_sphere_with_holes_only_is_the_sphere_without_them() {
     let d = n.domain();
     let mut checked = 0;
     let mut wrong = Vec::new();
-    for i in 0..=40 {
+    for i in 1..40 {
         for j in 1..40 {
             let su = d.u0 + (d.u1 - d.u0) * i as f64 / 40.0;
             let sv = d.v0 + (d.v1 - d.v0) * j as f64 / 40.0;
             let p = n.eval(su, sv);
-            if (p.x.abs() - c).abs() < 0.05 {
-                continue;
-            }
+            let Some(inside) = expect(p) else { continue };
             checked += 1;
-            if region.contains(su, sv) != (p.x.abs() < c) {
+            if region.contains(su, sv) != inside {
                 wrong.push((su, sv, p));
             }
         }
@@ -483,8 +504,69 @@ fn a_sphere_with_holes_only_is_the_sphere_without_them() {
         "{} of {checked} wrong, e.g. {:?}; domain {d:?}, trims {:?}",
         wrong.len(),
         &wrong[..wrong.len().min(8)],
-        mapped_domain(&surface)
+        mapped_domain(surface)
     );
+}
+
+#[test]
+fn a_sphere_with_holes_only_is_the_sphere_without_them() {
+    check_sphere_with_holes(0.6, &[(DVec3::X, DVec3::Y), (-DVec3::X, DVec3::Y)], false);
+}
+
+/// Three holes around the equator, one across the seam (longitude 0), and a vertex loop
+/// at each pole, as Parasolid writes a drilled ball: every hole is cut, the one across
+/// the seam on both sides of it, wherever the first loop or a pole's arbitrary longitude
+/// puts the surface's range.
+#[test]
+fn holes_around_a_sphere_are_cut_across_its_seam() {
+    check_sphere_with_holes(
+        0.75,
+        &[
+            (-DVec3::X, DVec3::Z),
+            (DVec3::X, -DVec3::Y),
+            (DVec3::Y, DVec3::X),
+        ],
+        true,
+    );
+}
+
+/// A band of a cylinder between a circle through the seam and an oblique ellipse whose
+/// one vertex is a quarter turn from the seam (as Onshape writes a cut tube): the
+/// ellipse's loop winds once around from that vertex, and bounds the band all around,
+/// not only over the turn that starts there.
+#[test]
+fn a_band_under_an_ellipse_starting_off_the_seam() {
+    let k = 0.3;
+    let mut w = StepWriter::default();
+    let ax = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
+    let cyl = w.add(format!(
+        "CYLINDRICAL_SURFACE('',#{ax},{})",
+        step_support::real(1.0)
+    ));
+    let circle = w.circle(ax, 1.0);
+    let v0 = w.vertex(DVec3::X);
+    let bottom = w.edge(v0, v0, circle, true);
+    // The plane z = 1 + k x cuts the cylinder in the ellipse about (0, 0, 1) with
+    // semi-axes √(1 + k²) along (1, 0, k) and 1 along y.
+    let tilt = DVec3::new(1.0, 0.0, k).normalize();
+    let eax = w.axis(DVec3::Z, DVec3::new(-k, 0.0, 1.0).normalize(), tilt);
+    let ellipse = w.add(format!(
+        "ELLIPSE('',#{eax},{},{})",
+        step_support::real((1.0 + k * k).sqrt()),
+        step_support::real(1.0)
+    ));
+    let v1 = w.vertex(DVec3::new(0.0, 1.0, 1.0));
+    let top = w.edge(v1, v1, ellipse, true);
+    let bounds = [
+        w.bound(&[(bottom, true)], false),
+        w.bound(&[(top, false)], false),
+    ];
+    w.face(&bounds, cyl);
+    let surface = only_surface(&read(&w.finish()));
+    assert_region(&surface, |p| {
+        let top = 1.0 + k * p.x;
+        (p.z.abs() > 0.05 && (p.z - top).abs() > 0.05).then_some(p.z > 0.0 && p.z < top)
+    });
 }
 
 /// A sphere cap bounded by a circle and a seam run down to the pole and back, whose

@@ -239,6 +239,59 @@ impl Domain<'_> {
     }
 }
 
+/// A loop of a face on a surface periodic in some parameter, placed on the surface's range
+/// `[lo, hi]` (one period or less along a periodic axis) and copied a period over where it
+/// reaches beyond it: a hole across the seam is cut on both sides of it. A closed loop
+/// is first moved by whole periods to lie nearest the range's middle; a loop winding
+/// around the axis (closed beyond the range already) spans a whole period from wherever
+/// its first vertex is: moved to start nearest the range's start, the copy a period over
+/// covers the rest of the range, and the two copies' closing lines at that vertex
+/// coincide and cancel under even–odd parity.
+fn across_range(
+    pieces: &mut [Piece],
+    winds: Option<usize>,
+    lo: DVec2,
+    hi: DVec2,
+    periods: [Option<f64>; 2],
+) -> Vec<Vec<Piece>> {
+    let mut copies = Vec::new();
+    for axis in 0..2 {
+        let Some(p) = periods[axis] else { continue };
+        let extent = |pieces: &[Piece]| {
+            pieces
+                .iter()
+                .flat_map(Piece::samples)
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
+                    (a.min(q[axis]), b.max(q[axis]))
+                })
+        };
+        let (a, b) = extent(pieces);
+        let turns = if winds == Some(axis) {
+            ((lo[axis] - a) / p).round()
+        } else {
+            ((0.5 * (lo[axis] + hi[axis]) - 0.5 * (a + b)) / p).round()
+        };
+        if turns != 0.0 {
+            let mut d = DVec2::ZERO;
+            d[axis] = turns * p;
+            pieces.iter_mut().for_each(|q| q.shift(d));
+        }
+        let (a, b) = extent(pieces);
+        let slack = 1e-9 * p;
+
+        for (beyond, by) in [(a < lo[axis] - slack, p), (b > hi[axis] + slack, -p)] {
+            if beyond {
+                let mut d = DVec2::ZERO;
+                d[axis] = by;
+                let mut copy = pieces.to_vec();
+                copy.iter_mut().for_each(|q| q.shift(d));
+                copies.push(copy);
+            }
+        }
+    }
+    copies
+}
+
 /// The parameter interval `[ta, tb]` of the edge on its 3D curve (increasing) and whether
 /// the edge runs along the curve: vertices located on the curve, periodic curves
 /// unwrapped, a closed edge taking a whole period (or the whole B-spline).
@@ -675,23 +728,27 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
                 false,
             ));
         }
-        trims.push(TrimLoop {
-            // Holes only: the surface's domain is the outer bound (`geom::trim`).
-            hole: all_holes || k > 0,
-            // A segment runs from t0 to t1 in either order (`geom::trim`): reversed
-            // pieces swap them, so each segment starts where the previous one ended.
-            segments: pieces
-                .into_iter()
-                .map(|p| match p.reversed {
-                    false => p.seg,
-                    true => TrimSegment {
-                        t0: p.seg.t1,
-                        t1: p.seg.t0,
-                        curve: p.seg.curve,
-                    },
-                })
-                .collect(),
-        });
+        // Holes only: the surface's domain is the outer bound (`geom::trim`).
+        let hole = all_holes || k > 0;
+        let copies = across_range(&mut pieces, winds, lo, hi, dom.periods);
+        for pieces in std::iter::once(pieces).chain(copies) {
+            trims.push(TrimLoop {
+                hole,
+                // A segment runs from t0 to t1 in either order (`geom::trim`): reversed
+                // pieces swap them, so each segment starts where the previous one ended.
+                segments: pieces
+                    .into_iter()
+                    .map(|p| match p.reversed {
+                        false => p.seg,
+                        true => TrimSegment {
+                            t0: p.seg.t1,
+                            t1: p.seg.t0,
+                            curve: p.seg.curve,
+                        },
+                    })
+                    .collect(),
+            });
+        }
     }
     let mut surface = Surface {
         geometry: SurfaceGeometry::Nurbs(nurbs),
