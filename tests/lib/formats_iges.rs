@@ -366,17 +366,21 @@ fn offset_of_a_surface_of_revolution_of_a_line() {
     let (l0, l1) = (DVec3::new(1.0, 0.0, 0.0), DVec3::new(2.0, 0.0, 2.0));
     let (axis_0, axis_1) = (DVec3::new(0.0, 0.0, -1.0), DVec3::new(0.0, 0.0, 4.0));
     let d = 0.25;
-    let mut offset = ent(140, &[0.0, 0.0, 0.0, d, de(3)]);
-    offset.subordinate = 0;
-    let read_offset = read(&[
-        ent(
-            110,
-            &[axis_0.x, axis_0.y, axis_0.z, axis_1.x, axis_1.y, axis_1.z],
-        ),
-        ent(110, &[l0.x, l0.y, l0.z, l1.x, l1.y, l1.z]),
-        offset,
-        ent(120, &[de(0), de(1), 0.0, 1.5 * PI]),
-    ]);
+    // The 140 over a 120 of the line from `g0` to `g1` about the axis, through `sweep`.
+    let offset_file = |g0: DVec3, g1: DVec3, sweep: f64| {
+        let mut offset = ent(140, &[0.0, 0.0, 0.0, d, de(3)]);
+        offset.subordinate = 0;
+        read(&[
+            ent(
+                110,
+                &[axis_0.x, axis_0.y, axis_0.z, axis_1.x, axis_1.y, axis_1.z],
+            ),
+            ent(110, &[g0.x, g0.y, g0.z, g1.x, g1.y, g1.z]),
+            offset,
+            ent(120, &[de(0), de(1), 0.0, sweep]),
+        ])
+    };
+    let read_offset = offset_file(l0, l1, 1.5 * PI);
     assert!(
         read_offset.report.failed.is_empty(),
         "{:?}",
@@ -397,17 +401,7 @@ fn offset_of_a_surface_of_revolution_of_a_line() {
     }
     // A line skew to the axis sweeps a hyperboloid, whose offset is no NURBS: refused,
     // and the refusal says so.
-    let mut skew = ent(140, &[0.0, 0.0, 0.0, d, de(3)]);
-    skew.subordinate = 0;
-    let refused = read(&[
-        ent(
-            110,
-            &[axis_0.x, axis_0.y, axis_0.z, axis_1.x, axis_1.y, axis_1.z],
-        ),
-        ent(110, &[1.0, 0.0, 0.0, 1.0, 1.0, 2.0]),
-        skew,
-        ent(120, &[de(0), de(1), 0.0, PI]),
-    ]);
+    let refused = offset_file(DVec3::new(1.0, 0.0, 0.0), DVec3::new(1.0, 1.0, 2.0), PI);
     let why: Vec<String> = refused
         .report
         .failed
