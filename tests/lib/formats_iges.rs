@@ -21,6 +21,7 @@ const REL: f64 = 1e-12;
 // ---------------------------------------------------------------------------------------
 // Entities for the writer in `iges_support`.
 
+#[derive(Clone)]
 struct Ent {
     ty: i32,
     form: i32,
@@ -1223,6 +1224,30 @@ fn manifold_solid_b_rep_faces_with_edge_lists_and_loops() {
             1.0, 0.0, 0.0, shift.x, 0.0, 1.0, 0.0, shift.y, 0.0, 0.0, 1.0, shift.z,
         ],
     ));
+    // The same faces drawn on their own: the shell without its solid, and one face
+    // without a shell, each marked independent (as some writers leave them); and the
+    // solid's faces and shell marked independent too are still drawn once.
+    let drawn = |ents: &[Ent]| {
+        let r = read(ents);
+        assert!(r.report.failed.is_empty(), "{:?}", r.report.failed);
+        r.surfaces.len()
+    };
+    let independent = |mut e: Ent| {
+        e.subordinate = 0;
+        e
+    };
+    let mut lone_shell = ents[..13].to_vec();
+    lone_shell.push(independent(ents[13].clone()));
+    assert_eq!(drawn(&lone_shell), 2, "a lone 514");
+    let mut lone_face = ents[..9].to_vec();
+    lone_face.push(independent(ents[9].clone()));
+    assert_eq!(drawn(&lone_face), 1, "a lone 510");
+    let all_independent: Vec<Ent> = ents.iter().cloned().map(independent).collect();
+    assert_eq!(
+        drawn(&all_independent),
+        2,
+        "faces and shell of a solid, all independent"
+    );
     let read = read(&ents);
     assert!(read.report.failed.is_empty(), "{:?}", read.report.failed);
     assert!(read.report.ignored.is_empty(), "{:?}", read.report.ignored);

@@ -388,6 +388,10 @@ pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
                 through_others.insert(*surface);
             }
             Entity::Subfigure(members) => through_others.extend(members.iter().copied()),
+            // Faces and shells of a solid (or shell) are drawn through it, whatever
+            // their status says.
+            Entity::Shell(faces) => through_others.extend(faces.iter().copied()),
+            Entity::Brep { shells } => through_others.extend(shells.iter().copied()),
             _ => {}
         }
     }
@@ -467,6 +471,8 @@ fn draw(
         | Entity::Revolution { .. }
         | Entity::Offset { .. }
         | Entity::Tabulated { .. } => trimmed::untrimmed(model, pointer, report),
+        // A face (510) drawn on its own: a file of faces without a solid.
+        Entity::Face { .. } => trimmed::face(model, pointer, report),
         Entity::Brep { shells } => {
             // §4.2 (186): every face of the outer and void shells, each its own trimmed
             // surface, in the solid's colour unless the face has its own.
@@ -475,26 +481,23 @@ fn draw(
                 Err(why) => return fail(report, why),
             };
             for &shell in shells {
-                let faces = match model.get(shell) {
-                    Ok((_, Entity::Shell(faces))) => faces,
+                match model.get(shell) {
+                    Ok((_, Entity::Shell(faces))) => {
+                        draw_faces(model, faces, &solid, colour, report, out);
+                    }
                     Ok(_) => {
                         return fail(report, format!("the shell D {shell} is not a shell (514)"));
                     }
                     Err(why) => return fail(report, why),
-                };
-                for &f in faces {
-                    let face_colour = model.get(f).ok().and_then(|(e, _)| model.colour(e));
-                    match trimmed::face(model, f, report) {
-                        Ok(mut surface) => {
-                            surface.transform(&solid);
-                            out.push(Drawn {
-                                surface,
-                                colour: face_colour.or(colour),
-                            });
-                        }
-                        Err(why) => report.failed.push(failure(510, f, why)),
-                    }
                 }
+            }
+            return;
+        }
+        // A shell (514) drawn on its own, its faces in its colour.
+        Entity::Shell(faces) => {
+            match model.transform(entry.transform) {
+                Ok(t) => draw_faces(model, faces, &(*m * t), colour, report, out),
+                Err(why) => fail(report, why),
             }
             return;
         }
@@ -561,6 +564,31 @@ fn draw(
             out.push(Drawn { surface, colour });
         }
         Err(why) => fail(report, why),
+    }
+}
+
+/// The faces (510) of a shell, each its own trimmed surface placed by `placement`, in its
+/// own colour or else `colour` (the shell's or its solid's).
+fn draw_faces(
+    model: &Model,
+    faces: &[usize],
+    placement: &DAffine3,
+    colour: Option<DVec3>,
+    report: &mut Report,
+    out: &mut Vec<Drawn>,
+) {
+    for &f in faces {
+        let face_colour = model.get(f).ok().and_then(|(e, _)| model.colour(e));
+        match trimmed::face(model, f, report) {
+            Ok(mut surface) => {
+                surface.transform(placement);
+                out.push(Drawn {
+                    surface,
+                    colour: face_colour.or(colour),
+                });
+            }
+            Err(why) => report.failed.push(failure(510, f, why)),
+        }
     }
 }
 
