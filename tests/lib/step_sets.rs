@@ -27,6 +27,11 @@ const INNER: f64 = 1.0;
 /// z = −5, both in one GEOMETRIC_SET; the annulus's boundaries are circles without
 /// pcurves (projected onto the plane).
 fn set_file() -> String {
+    set_writer().0.finish()
+}
+
+/// The writer of `set_file` before it is finished, and the curve-bounded annulus's id.
+fn set_writer() -> (StepWriter, u64) {
     let mut w = StepWriter {
         degrees: true,
         ..Default::default()
@@ -51,7 +56,48 @@ fn set_file() -> String {
     ));
     let set = w.add(format!("GEOMETRIC_SET('',(#{rts},#{cbs}))"));
     w.items.push(set);
-    w.finish()
+    (w, cbs)
+}
+
+/// The set's surfaces, one of them also the representation of a shape aspect of the
+/// product (as AutoCAD writes each surface of its set again): each drawn once.
+#[test]
+fn a_set_s_surface_named_again_by_a_shape_aspect_is_drawn_once() {
+    let (mut w, cbs) = set_writer();
+    let ctx = w.add("(GEOMETRIC_REPRESENTATION_CONTEXT(3) REPRESENTATION_CONTEXT('',''))");
+    let mut text = w.finish();
+    // The product: its definition shape holds the finished model (the last entity).
+    let main = text.matches("\n#").count() as u64;
+    let mut extra = step_support::StepWriter {
+        next: main,
+        ..Default::default()
+    };
+    let pd = extra.add("PRODUCT_DEFINITION('part','',$,$)");
+    let pds = extra.add(format!("PRODUCT_DEFINITION_SHAPE('','',#{pd})"));
+    extra.add(format!("SHAPE_DEFINITION_REPRESENTATION(#{pds},#{main})"));
+    let aspect = extra.add(format!(
+        "SHAPE_ASPECT('','solid associated with shape',#{pds},.F.)"
+    ));
+    let property = extra.add(format!("PROPERTY_DEFINITION('','',#{aspect})"));
+    let aspect_rep = extra.add(format!("SHAPE_REPRESENTATION('',(#{cbs}),#{ctx})"));
+    extra.add(format!(
+        "SHAPE_DEFINITION_REPRESENTATION(#{property},#{aspect_rep})"
+    ));
+    text = text.replace(
+        "\nENDSEC;\nEND-ISO-10303-21;",
+        &format!("\n{}\nENDSEC;\nEND-ISO-10303-21;", extra.lines.join("\n")),
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("aspect.step");
+    std::fs::write(&path, &text).unwrap();
+    let surfaces = read_step(&path)
+        .unwrap()
+        .parts
+        .iter()
+        .flat_map(|p| &p.pieces)
+        .filter(|p| matches!(p.shape, Shape::Surface(_)))
+        .count();
+    assert_eq!(surfaces, 2, "{text}");
 }
 
 #[test]

@@ -282,7 +282,8 @@ pub fn occurrences(
 }
 
 /// Topological items that a representation outside `aspects` holds, directly or inside a
-/// solid or shell it holds (ISO 10303-42 §5.4: a solid's shells, a shell's faces).
+/// solid or shell it holds (ISO 10303-42 §5.4: a solid's shells, a shell's faces), and the
+/// elements of the geometric sets it holds.
 fn held_by(
     res: &Resolver,
     reps: &HashMap<u64, (Vec<u64>, Option<u64>)>,
@@ -298,7 +299,18 @@ fn held_by(
         let Some(inst) = res.ex.get(id) else {
             continue;
         };
-        if !TOPOLOGY.contains(&inst.records[0].name) || !held.insert(id) {
+        let name = &inst.records[0].name;
+        if SETS.contains(name) && held.insert(id) {
+            // A geometric_set (ISO 10303-42)'s elements (bare surfaces, curves) are held as
+            // they are; nothing below them is shared with an aspect.
+            let mut elements = Vec::new();
+            for r in &inst.records {
+                push_references(&r.params, &mut elements);
+            }
+            held.extend(elements);
+            continue;
+        }
+        if !TOPOLOGY.contains(name) || !held.insert(id) {
             continue;
         }
         for r in &inst.records {
@@ -307,6 +319,10 @@ fn held_by(
     }
     held
 }
+
+/// Geometric sets, whose elements a shape aspect may name again (AutoCAD writes each
+/// surface of a set as an aspect's representation too).
+const SETS: [&str; 2] = ["GEOMETRIC_SET", "GEOMETRIC_CURVE_SET"];
 
 /// The entities a solid or shell is made of, down to its faces.
 const TOPOLOGY: [&str; 10] = [
