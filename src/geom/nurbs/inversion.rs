@@ -1,21 +1,35 @@
 //! Point inversion: the point of a NURBS surface closest to a point in space (Piegl &
 //! Tiller, *The NURBS Book*, §6.1). CAD readers use it to bring trim curves given only in
-//! model space (IGES 142 without a parameter-space curve) into the surface's domain, and
-//! report the distance as the projection's error.
+//! model space (IGES 142 without a parameter-space curve, STEP edges without pcurves) into
+//! the surface's domain, and report the distance as the projection's error.
 //!
 //! As §6.1 advises, the start comes from sampling: the surface is cut into its exact
-//! Bézier patches and each is sampled on a grid; from the few nearest samples, Gauss–Newton
-//! on `S(u, v) − P` (quadratic where the point lies on the surface, which is the case the
-//! readers care about; linear otherwise) runs inside the patch, clamped to it, with step
-//! halving so the distance never grows. The best of these is the answer.
+//! Bézier patches and each is sampled on a grid, its steps shared between the two
+//! directions in proportion to the patch's extent along them; from the few nearest
+//! samples, Gauss–Newton on `S(u, v) − P` (quadratic where the point lies on the surface,
+//! which is the case the readers care about; linear otherwise) runs over the whole
+//! surface, clamped to its domain, with step halving so the distance never grows. The
+//! best of these is the answer.
+//!
+//! Both choices come from long thin patches (a lofted tube a hundred times longer than
+//! its patches are wide around it). A square grid on such a patch leaves rings of samples
+//! far apart along the tube, and the nearest sample to a point between two rings can lie
+//! across the tube from it; a descent confined to the patch of its start then stops at
+//! that patch's edge, a patch corner far from the point, which was kept as the answer.
 
 use glam::DVec3;
 
 use super::surface::NurbsSurface;
 use crate::geom::bezier::BezierPatch;
 
-/// Grid steps per patch direction of the start samples.
+/// Grid steps per patch direction of the start samples on a patch as long as wide; a
+/// patch k times longer than wide gets √k times more steps along its length and √k
+/// times fewer across (at least one), so the samples of a long thin patch (a tube of a
+/// hundred such around its circumference) are as far apart along it as across the tube,
+/// and the nearest sample is near the nearest point.
 const SAMPLES: usize = 8;
+/// Most grid steps along one patch direction.
+const MAX_SAMPLES: usize = SAMPLES * SAMPLES;
 /// How many of the nearest samples start a descent: more than one, because the nearest
 /// sample can sit across a fold from the nearest point.
 const STARTS: usize = 4;
@@ -36,26 +50,53 @@ pub struct Projection {
     pub distance: f64,
 }
 
-/// A surface prepared for many inversions: its Bézier patches and start samples.
+/// A surface prepared for many inversions: its Bézier patches, where each lies in the
+/// parameter plane, and start samples.
 pub struct Inverter {
+    /// The patches in span order, u spans fastest
+    /// ([`NurbsSurface::to_bezier_patches`]).
     patches: Vec<BezierPatch>,
-    /// (patch, local u, local v, point).
-    samples: Vec<(usize, f64, f64, DVec3)>,
+    /// The patches' span ends in u and in v, increasing: patch (a, b) covers
+    /// `[breaks_u[a], breaks_u[a + 1]] × [breaks_v[b], breaks_v[b + 1]]`.
+    breaks_u: Vec<f64>,
+    breaks_v: Vec<f64>,
+    /// (u, v, point).
+    samples: Vec<(f64, f64, DVec3)>,
 }
 
 impl Inverter {
     pub fn new(surface: &NurbsSurface) -> Inverter {
         let patches = surface.to_bezier_patches();
-        let mut samples = Vec::with_capacity(patches.len() * (SAMPLES + 1) * (SAMPLES + 1));
-        for (k, patch) in patches.iter().enumerate() {
-            for i in 0..=SAMPLES {
-                for j in 0..=SAMPLES {
-                    let (s, t) = (i as f64 / SAMPLES as f64, j as f64 / SAMPLES as f64);
-                    samples.push((k, s, t, patch.eval(s, t)));
+        let mut samples = Vec::new();
+        let (mut breaks_u, mut breaks_v) = (Vec::new(), Vec::new());
+        for patch in &patches {
+            let d = patch.domain();
+            // The first row of patches gives the u spans, the first column the v spans.
+            if breaks_v.is_empty() || d.v0 == breaks_v[0] {
+                breaks_u.push(d.u0);
+            }
+            if breaks_u.is_empty() || d.u0 == breaks_u[0] {
+                breaks_v.push(d.v0);
+            }
+            let (steps_u, steps_v) = sample_steps(patch);
+            for i in 0..=steps_u {
+                for j in 0..=steps_v {
+                    let (s, t) = (i as f64 / steps_u as f64, j as f64 / steps_v as f64);
+                    let (u, v) = d.to_parent(s, t);
+                    samples.push((u, v, patch.eval(s, t)));
                 }
             }
         }
-        Inverter { patches, samples }
+        if let Some(last) = patches.last() {
+            breaks_u.push(last.domain().u1);
+            breaks_v.push(last.domain().v1);
+        }
+        Inverter {
+            patches,
+            breaks_u,
+            breaks_v,
+            samples,
+        }
     }
 
     /// The closest point of the surface to `p`; `None` for a surface without patches or a
@@ -79,7 +120,7 @@ impl Inverter {
             .samples
             .iter()
             .enumerate()
-            .map(|(i, s)| (s.3.distance_squared(p), i))
+            .map(|(i, s)| (s.2.distance_squared(p), i))
             .collect();
         let starts = STARTS.min(near.len());
         if starts == 0 {
@@ -89,49 +130,112 @@ impl Inverter {
         near[..starts]
             .iter()
             .map(|&(_, i)| {
-                let (k, s, t, _) = self.samples[i];
-                let patch = &self.patches[k];
-                let (s, t, d) = descend(patch, p, s, t);
-                let (u, v) = patch.domain().to_parent(s, t);
-                Projection { u, v, distance: d }
+                let (u, v, _) = self.samples[i];
+                self.descend(p, u, v)
             })
             .min_by(|a, b| a.distance.total_cmp(&b.distance))
     }
-}
 
-/// Gauss–Newton for min |S(s, t) − p| on one patch's [0, 1]², from (s, t): each step solves
-/// the 2 × 2 normal equations JᵀJ δ = −Jᵀr (r = S − p, J = [S_s S_t]), clamps to the
-/// patch, and is halved until the distance does not grow (beyond rounding).
-fn descend(patch: &BezierPatch, p: DVec3, mut s: f64, mut t: f64) -> (f64, f64, f64) {
-    let mut dist = (patch.eval(s, t) - p).length();
-    let slack = FLAT_ULPS * f64::EPSILON * (p.abs().max_element() + dist);
-    for _ in 0..MAX_STEPS {
+    /// The patch under (u, v), a point of the domain, and its local parameters there.
+    fn locate(&self, u: f64, v: f64) -> (&BezierPatch, f64, f64) {
+        let span = |breaks: &[f64], x: f64| {
+            let k = breaks
+                .partition_point(|&b| b <= x)
+                .clamp(1, breaks.len() - 1)
+                - 1;
+            let (lo, hi) = (breaks[k], breaks[k + 1]);
+            (k, lo, hi - lo)
+        };
+        let (a, u0, du) = span(&self.breaks_u, u);
+        let (b, v0, dv) = span(&self.breaks_v, v);
+        let patch = &self.patches[b * (self.breaks_u.len() - 1) + a];
+        (patch, (u - u0) / du, (v - v0) / dv)
+    }
+
+    /// The point and first partial derivatives in the surface's own parameters.
+    fn derivatives(&self, u: f64, v: f64) -> (DVec3, DVec3, DVec3) {
+        let (patch, s, t) = self.locate(u, v);
+        let d = patch.domain();
         let (point, ss, st) = patch.derivatives(s, t);
-        let r = point - p;
-        let (a, b, c) = (ss.dot(ss), ss.dot(st), st.dot(st));
-        let (g0, g1) = (ss.dot(r), st.dot(r));
-        let det = a * c - b * b;
-        if !(det > 0.0 && det.is_finite()) {
-            break;
-        }
-        let (mut ds, mut dt) = (-(c * g0 - b * g1) / det, -(a * g1 - b * g0) / det);
-        let mut improved = false;
-        for _ in 0..MAX_HALVINGS {
-            let (ns, nt) = ((s + ds).clamp(0.0, 1.0), (t + dt).clamp(0.0, 1.0));
-            let nd = (patch.eval(ns, nt) - p).length();
-            if nd <= dist + slack {
-                improved = (ns, nt) != (s, t);
-                (s, t, dist) = (ns, nt, nd);
+        (point, ss / (d.u1 - d.u0), st / (d.v1 - d.v0))
+    }
+
+    fn eval(&self, u: f64, v: f64) -> DVec3 {
+        let (patch, s, t) = self.locate(u, v);
+        patch.eval(s, t)
+    }
+
+    /// Gauss–Newton for min |S(u, v) − p| from (u, v): each step solves the 2 × 2 normal
+    /// equations JᵀJ δ = −Jᵀr (r = S − p, J = [S_u S_v]), clamps to the domain, and is
+    /// halved until the distance does not grow (beyond rounding).
+    fn descend(&self, p: DVec3, mut u: f64, mut v: f64) -> Projection {
+        let (u_lo, u_hi) = (self.breaks_u[0], self.breaks_u[self.breaks_u.len() - 1]);
+        let (v_lo, v_hi) = (self.breaks_v[0], self.breaks_v[self.breaks_v.len() - 1]);
+        let mut dist = (self.eval(u, v) - p).length();
+        let slack = FLAT_ULPS * f64::EPSILON * (p.abs().max_element() + dist);
+        for _ in 0..MAX_STEPS {
+            let (point, su, sv) = self.derivatives(u, v);
+            let r = point - p;
+            let (a, b, c) = (su.dot(su), su.dot(sv), sv.dot(sv));
+            let (g0, g1) = (su.dot(r), sv.dot(r));
+            let det = a * c - b * b;
+            if !(det > 0.0 && det.is_finite()) {
                 break;
             }
-            ds *= 0.5;
-            dt *= 0.5;
+            let (mut du, mut dv) = (-(c * g0 - b * g1) / det, -(a * g1 - b * g0) / det);
+            let mut improved = false;
+            for _ in 0..MAX_HALVINGS {
+                let (nu, nv) = ((u + du).clamp(u_lo, u_hi), (v + dv).clamp(v_lo, v_hi));
+                let nd = (self.eval(nu, nv) - p).length();
+                if nd <= dist + slack {
+                    improved = (nu, nv) != (u, v);
+                    (u, v, dist) = (nu, nv, nd);
+                    break;
+                }
+                du *= 0.5;
+                dv *= 0.5;
+            }
+            if !improved {
+                break;
+            }
         }
-        if !improved {
-            break;
+        Projection {
+            u,
+            v,
+            distance: dist,
         }
     }
-    (s, t, dist)
+}
+
+/// Grid steps along u and v of `patch`'s start samples ([`SAMPLES`]). The extent along a
+/// direction is the longest control polygon line that way: for a polynomial patch it
+/// bounds the length of every iso-line along it (a Bézier curve is no longer than its
+/// control polygon, and an iso-line's polygon is a convex combination of those lines).
+fn sample_steps(patch: &BezierPatch) -> (usize, usize) {
+    let (du, dv) = (patch.degree_u(), patch.degree_v());
+    let polygon = |points: &mut dyn Iterator<Item = DVec3>| {
+        let first = points.next().unwrap_or(DVec3::ZERO);
+        points
+            .fold((0.0, first), |(l, a), b| (l + a.distance(b), b))
+            .0
+    };
+    let along_u = (0..=dv)
+        .map(|j| polygon(&mut (0..=du).map(|i| patch.point(i, j))))
+        .fold(0.0, f64::max);
+    let along_v = (0..=du)
+        .map(|i| polygon(&mut (0..=dv).map(|j| patch.point(i, j))))
+        .fold(0.0, f64::max);
+    let ratio = (along_u / along_v).sqrt();
+    if !(ratio.is_finite() && ratio > 0.0) {
+        // A collapsed direction (or both): its samples would all be the same point.
+        return match (along_u > 0.0, along_v > 0.0) {
+            (true, false) => (MAX_SAMPLES, 1),
+            (false, true) => (1, MAX_SAMPLES),
+            _ => (SAMPLES, SAMPLES),
+        };
+    }
+    let steps = |k: f64| ((SAMPLES as f64 * k).round() as usize).clamp(1, MAX_SAMPLES);
+    (steps(ratio), steps(1.0 / ratio))
 }
 
 #[cfg(test)]

@@ -106,3 +106,68 @@ fn a_meridian_from_the_pole_keeps_its_longitude() {
         p.points.len()
     );
 }
+
+/// A long, thin, tapering tube whose rings are tilted against its axis, as CAD systems
+/// write a lofted rod: degree 1 along its length (u, clamped), and around it (v) an
+/// unclamped uniform closed cubic B-spline over `N` control points on a circle, domain
+/// [0, 1] inside knots from −3/N to 1 + 3/N. Its patches are about a hundred times
+/// longer than wide, and a sample ring of the inverter's start grid passes a point
+/// between rings on the wrong side of the tube.
+fn tilted_tube() -> (NurbsSurface, impl Fn(usize) -> [DVec3; 2]) {
+    const N: usize = 32;
+    let (length, radius, tilt, taper) = (100.0, 1.5, 20.0, 0.5);
+    let ring = |m: usize| {
+        let a = TAU * m as f64 / N as f64;
+        DVec3::new(0.0, radius * a.cos(), radius * a.sin())
+    };
+    let far = move |q: DVec3| DVec3::new(length + tilt * taper * q.y, taper * q.y, taper * q.z);
+    let points = (0..N + 3)
+        .flat_map(|m| [ring(m).extend(1.0), far(ring(m)).extend(1.0)])
+        .collect();
+    let knots_v = (0..N + 7).map(|i| (i as f64 - 3.0) / N as f64).collect();
+    let s = NurbsSurface::new(1, 3, vec![0.0, 0.0, 1.0, 1.0], knots_v, 2, N + 3, points).unwrap();
+    // The ends of the iso-line v = c / N, in closed form: at a knot a uniform cubic
+    // B-spline is (Q_c + 4 Q_{c+1} + Q_{c+2}) / 6, on the circle of radius
+    // r (2 + cos(2π/N)) / 3 at angle 2π (c + 1) / N, and the surface is affine in u.
+    let iso = move |c: usize| {
+        let a = TAU * (c + 1) as f64 / N as f64;
+        let rho = radius * (2.0 + (TAU / N as f64).cos()) / 3.0;
+        let near = DVec3::new(0.0, rho * a.cos(), rho * a.sin());
+        [near, far(near)]
+    };
+    (s, iso)
+}
+
+#[test]
+fn iso_lines_of_a_thin_unclamped_closed_tube_project_onto_themselves() {
+    // The straight line between the ends of the iso-line v = c / N is that iso-line, with
+    // u its own parameter: every projected vertex must have v = c / N, and points along
+    // it must invert to (t, c / N).
+    let (s, iso) = tilted_tube();
+    let target = NurbsTarget::new(&s);
+    let n = 32;
+    for c in 1..n {
+        let v = c as f64 / n as f64;
+        let [a, b] = iso(c);
+        let line = |t: f64| a.lerp(b, t);
+        for k in 0..=16 {
+            let t = k as f64 / 16.0;
+            let uv = target.parameters(line(t)).unwrap();
+            assert!(
+                (uv - DVec2::new(t, v)).length() < 1e-9,
+                "v = {v}, t = {t}: {uv}"
+            );
+        }
+        let p = project(&target, line, 0.0, 1.0, 1e-6).unwrap();
+        assert!(p.error < 1e-9, "v = {v}: error {}", p.error);
+        assert!(
+            (p.points[0] - DVec2::new(0.0, v)).length() < 1e-9,
+            "v = {v}"
+        );
+        let end = *p.points.last().unwrap();
+        assert!((end - DVec2::new(1.0, v)).length() < 1e-9, "v = {v}: {end}");
+        for q in &p.points {
+            assert!((q.y - v).abs() < 1e-9, "v = {v}: {q}");
+        }
+    }
+}

@@ -62,6 +62,10 @@ pub struct Report {
     /// distance between such an edge and its trim, in millimetres.
     pub projected_edges: usize,
     pub max_projection_error: f64,
+    /// Faces kept with a projected edge farther from their surface than a pcurve may stray
+    /// from its edge (the edge is not on the surface, or its projection failed), and that
+    /// distance, in millimetres: `(#id, distance)`.
+    pub stray_projections: Vec<(u64, f64)>,
     /// Placed occurrences of shape representations; 1 for a single part.
     pub occurrences: usize,
     pub colours: usize,
@@ -284,17 +288,20 @@ pub fn read_model(path: &Path, src: &str) -> Result<(CadModel, Report), ParseErr
         .collect();
     let mut converted: HashMap<u64, Shape> = HashMap::new();
     for (id, outcome) in outcomes {
+        if let Ok(Converted::Face(out) | Converted::Surface(out)) = &outcome {
+            report.projected_edges += out.projected_edges;
+            report.max_projection_error = report.max_projection_error.max(out.projection_error);
+            if out.projection_error > size * topology::PCURVE_TOLERANCE {
+                report.stray_projections.push((id, out.projection_error));
+            }
+        }
         match outcome {
             Ok(Converted::Face(out)) => {
                 report.faces += 1;
-                report.projected_edges += out.projected_edges;
-                report.max_projection_error = report.max_projection_error.max(out.projection_error);
                 converted.insert(id, Shape::Surface(out.surface));
             }
             Ok(Converted::Surface(out)) => {
                 report.surfaces += 1;
-                report.projected_edges += out.projected_edges;
-                report.max_projection_error = report.max_projection_error.max(out.projection_error);
                 converted.insert(id, Shape::Surface(out.surface));
             }
             Ok(Converted::Mesh(mesh)) => {
@@ -307,6 +314,10 @@ pub fn read_model(path: &Path, src: &str) -> Result<(CadModel, Report), ParseErr
     }
     report.failed_faces.sort_by_key(|(id, _)| *id);
     report.max_projection_error *= report.units.length.factor;
+    report.stray_projections.sort_by_key(|(id, _)| *id);
+    for (_, d) in &mut report.stray_projections {
+        *d *= report.units.length.factor;
+    }
     let mut model = CadModel::new(
         "STEP",
         "face",
@@ -349,6 +360,19 @@ pub fn read_model(path: &Path, src: &str) -> Result<(CadModel, Report), ParseErr
     report.unsupported = unsupported;
     model.held = held(&ex, seen.len());
     model.warnings = ex.warnings.clone();
+    if !report.stray_projections.is_empty() {
+        let listed: Vec<String> = report
+            .stray_projections
+            .iter()
+            .map(|(id, d)| format!("#{id} ({d:.3e} mm)"))
+            .collect();
+        model.warnings.push(format!(
+            "{} face(s) trimmed by edges projected more than {:e} of the model's size from their surface: {}",
+            listed.len(),
+            topology::PCURVE_TOLERANCE,
+            listed.join(" ")
+        ));
+    }
     model.notes = report.lines();
     model.skipped = report.unsupported.clone();
     model.failures = report

@@ -33,7 +33,7 @@ use crate::scene::model::{Surface, SurfaceGeometry};
 
 /// How far a pcurve may stray from its 3D curve, relative to the model's size, and still
 /// be used: CAD systems write edges to tolerances of about 1e-7 to 1e-4 of the part.
-const PCURVE_TOLERANCE: f64 = 1e-4;
+pub(super) const PCURVE_TOLERANCE: f64 = 1e-4;
 
 /// A converted face and what its conversion measured.
 pub struct FaceOutcome {
