@@ -416,8 +416,7 @@ impl Target<'_> {
     /// means nothing (the loop runs along the pole from one angle to another), so when a
     /// loop of projected curves then fails to close by whole periods, the curves after the
     /// last pole are moved back by them.
-    fn join(&self, parts: Vec<Part>, maps: &[AxisMap; 2]) -> Vec<TrimSegment> {
-        let mut parts = parts;
+    fn join(&self, mut parts: Vec<Part>, maps: &[AxisMap; 2]) -> Vec<TrimSegment> {
         let mut last: Option<DVec2> = None;
         let mut after_pole = [None; 2];
         for (i, part) in parts.iter_mut().enumerate() {
@@ -427,9 +426,8 @@ impl Target<'_> {
             };
             if let Some(prev) = last {
                 for k in 0..2 {
-                    let shift =
-                        pcurve::unwrap(points[0][k], prev[k], self.periods[k]) - points[0][k];
-                    points.iter_mut().for_each(|p| p[k] += shift);
+                    let by = pcurve::unwrap(points[0][k], prev[k], self.periods[k]) - points[0][k];
+                    points.iter_mut().for_each(|p| p[k] += by);
                     if pcurve::collapsed(self, prev, k, self.tolerance) {
                         after_pole[k] = Some(i);
                     }
