@@ -92,6 +92,20 @@ impl ParamCurve {
     pub fn domain(&self) -> (f64, f64) {
         crate::geom::nurbs::knots::domain(self.degree, &self.knots)
     }
+
+    /// The point at parameter `t` (de Boor on the homogeneous points, then divided).
+    pub fn point(&self, t: f64) -> DVec2 {
+        let c = crate::geom::nurbs::NurbsCurve {
+            degree: self.degree,
+            knots: self.knots.clone(),
+            points: self
+                .points
+                .iter()
+                .map(|p| glam::DVec4::new(p.x, p.y, 0.0, p.z))
+                .collect(),
+        };
+        c.eval(t).truncate()
+    }
 }
 
 impl TrimSegment {

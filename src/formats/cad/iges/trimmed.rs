@@ -280,7 +280,7 @@ fn with_loops(
                 let off = if e.model == 0 {
                     0.0
                 } else {
-                    stray_from_model(model, e, &c)?
+                    stray_from_model(model, e, &s, &c)?
                 };
                 if off <= far {
                     parts.extend(s.into_iter().map(Part::Given));
@@ -488,15 +488,20 @@ fn shift(parts: &mut [Part], k: usize, by: f64) {
 /// place.
 const STRAY: f64 = 1e-3;
 
-/// How far the parameter-space curves of an edge, laid on the surface, lie from its
-/// model-space curve: the largest distance of nine points per piece from the polyline
-/// through the model-space curve's samples. §4.22 (142) lets a writer give both curves
+/// How far the parameter-space curves of an edge (`given`, as trim segments), laid on the
+/// surface, lie from its model-space curve: the largest distance of nine points per piece
+/// from the polyline through the model-space curve's samples. §4.22 (142) lets a writer give both curves
 /// for one boundary; when they disagree by far more than rounding, the parameter-space
 /// one follows a parameterisation this reader does not share (SolidWorks measures the
 /// parameter of a 100 arc generatrix of a 120 from the arc's start, not as §4.3's
 /// angle), and the model-space curve, which needs none, is the one to draw, as
 /// OpenCASCADE's reading of such files shows.
-fn stray_from_model(model: &Model, e: &Edge, c: &Converted) -> Result<f64, String> {
+fn stray_from_model(
+    model: &Model,
+    e: &Edge,
+    given: &[TrimSegment],
+    c: &Converted,
+) -> Result<f64, String> {
     let polyline: Vec<DVec3> = edge_pieces(model, e.model, false)?
         .iter()
         .flat_map(samples)
@@ -511,23 +516,18 @@ fn stray_from_model(model: &Model, e: &Edge, c: &Converted) -> Result<f64, Strin
             x
         }
     };
-    let [(su, ou), (sv, ov)] = c.to_trim;
     let mut largest = 0.0f64;
-    for &pc in &e.parameter {
-        for piece in curves::pieces(model, pc)? {
-            for k in 0..=8 {
-                let q = piece
-                    .curve
-                    .eval(piece.t0 + (piece.t1 - piece.t0) * k as f64 / 8.0);
-                let u = into(c.maps[0].invert(su * q.x + ou), (d.u0, d.u1));
-                let v = into(c.maps[1].invert(sv * q.y + ov), (d.v0, d.v1));
-                let p = c.surface.eval(u, v);
-                let nearest = polyline
-                    .windows(2)
-                    .map(|w| distance_to_segment(p, w[0], w[1]))
-                    .fold(f64::INFINITY, f64::min);
-                largest = largest.max(nearest);
-            }
+    for seg in given {
+        for k in 0..=8 {
+            let q = seg.curve.point(seg.t0 + (seg.t1 - seg.t0) * k as f64 / 8.0);
+            let u = into(c.maps[0].invert(q.x), (d.u0, d.u1));
+            let v = into(c.maps[1].invert(q.y), (d.v0, d.v1));
+            let p = c.surface.eval(u, v);
+            let nearest = polyline
+                .windows(2)
+                .map(|w| distance_to_segment(p, w[0], w[1]))
+                .fold(f64::INFINITY, f64::min);
+            largest = largest.max(nearest);
         }
     }
     Ok(largest)

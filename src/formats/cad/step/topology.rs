@@ -20,7 +20,7 @@
 
 use std::collections::HashMap;
 
-use glam::{DVec2, DVec3, DVec4};
+use glam::{DVec2, DVec3};
 
 use super::entities::{Curve, Edge, Face, PCurve, SurfaceDef};
 use super::geometry::{curve_to_nurbs, surface_to_nurbs};
@@ -54,19 +54,6 @@ struct Piece {
     ends: [DVec2; 2],
 }
 
-/// The parameter-plane curve as a NURBS curve in the z = 0 plane, to evaluate it.
-fn as_nurbs(c: &ParamCurve) -> NurbsCurve {
-    NurbsCurve {
-        degree: c.degree,
-        knots: c.knots.clone(),
-        points: c
-            .points
-            .iter()
-            .map(|p| DVec4::new(p.x, p.y, 0.0, p.z))
-            .collect(),
-    }
-}
-
 /// A NURBS curve lying in z = 0 (a pcurve) as a parameter-plane curve.
 fn as_param(c: &NurbsCurve) -> ParamCurve {
     ParamCurve {
@@ -78,8 +65,7 @@ fn as_param(c: &NurbsCurve) -> ParamCurve {
 
 impl Piece {
     fn new(seg: TrimSegment, reversed: bool) -> Piece {
-        let c = as_nurbs(&seg.curve);
-        let (a, b) = (c.eval(seg.t0).truncate(), c.eval(seg.t1).truncate());
+        let (a, b) = (seg.curve.point(seg.t0), seg.curve.point(seg.t1));
         Piece {
             ends: if reversed { [b, a] } else { [a, b] },
             seg,
@@ -106,9 +92,8 @@ impl Piece {
 
     /// Points along the piece, for its extent.
     fn samples(&self) -> impl Iterator<Item = DVec2> + '_ {
-        let c = as_nurbs(&self.seg.curve);
         let (t0, t1) = (self.seg.t0, self.seg.t1);
-        (0..=16).map(move |k| c.eval(t0 + (t1 - t0) * k as f64 / 16.0).truncate())
+        (0..=16).map(move |k| self.seg.curve.point(t0 + (t1 - t0) * k as f64 / 16.0))
     }
 }
 
