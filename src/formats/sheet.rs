@@ -14,8 +14,9 @@ use glam::{DVec4, Vec3};
 
 use crate::geom::BezierPatch;
 use crate::geom::bezier::ParamRect;
-use crate::geom::trim::TrimLoop;
+use crate::geom::trim::clip::loops_within;
 use crate::geom::trim::reparam::loops_in_nurbs_space;
+use crate::geom::trim::{AxisMap, TrimLoop};
 use crate::scene::model::{Geometry, Scene, SurfaceGeometry};
 
 /// Bézier patches sharing their edges, over breakpoints in u and v, with trim loops.
@@ -116,7 +117,16 @@ pub fn scene_sheets(scene: &Scene) -> Result<Vec<Sheet>, String> {
                         continue;
                     };
                     let domain = span(&patches).unwrap_or(first.domain());
-                    let loops = loops_in_nurbs_space(&s.trims, &s.trim_space, domain)
+                    // Loops cut to the domain first, in the parameters they are written
+                    // in (where a loop closed beyond the range, around a closed surface,
+                    // runs past the angles the map knows), so that the written curves lie
+                    // in the surface's domain as IGES 142 and OBJ `trim` ask.
+                    let Some(loops) = loops_within(&s.trims, trim_rect(&s.trim_space, domain))
+                        .map_err(|e| located(e.to_string()))?
+                    else {
+                        continue;
+                    };
+                    let loops = loops_in_nurbs_space(&loops, &s.trim_space, domain)
                         .map_err(|e| located(e.to_string()))?;
                     out.extend(join(k, &patches, &loops));
                 }
@@ -139,6 +149,17 @@ pub fn scene_sheets(scene: &Scene) -> Result<Vec<Sheet>, String> {
         }
     }
     Ok(out)
+}
+
+/// The rectangle of trim parameters the NURBS domain `d` maps onto.
+fn trim_rect(maps: &[AxisMap; 2], d: ParamRect) -> ParamRect {
+    let ends = |m: &AxisMap, a: f64, b: f64| {
+        let (x, y) = (m.apply(a), m.apply(b));
+        (x.min(y), x.max(y))
+    };
+    let (u0, u1) = ends(&maps[0], d.u0, d.u1);
+    let (v0, v1) = ends(&maps[1], d.v0, d.v1);
+    ParamRect { u0, u1, v0, v1 }
 }
 
 /// The rectangle the patches cover.

@@ -13,10 +13,13 @@
 //!   wholly inside ones become trim-free at load.
 //! - [`axis_map`]: the map from a NURBS parameter to the (angle) parameter CAD files write
 //!   trims of analytic surfaces in.
+//! - [`clip`]: a region cut down to a rectangle, as closed loops, for writers whose
+//!   curves must lie in the surface's domain.
 //! - [`reparam`]: loops moved from that parameter to the NURBS one, for the writers of
 //!   formats that have no such map.
 
 pub mod axis_map;
+pub mod clip;
 pub mod crossing;
 pub mod pieces;
 pub mod region;
