@@ -17,7 +17,6 @@
 
 use glam::{DVec2, DVec3};
 
-use super::crossing::crosses_odd;
 use super::pieces::{Piece, loop_pieces, project};
 use super::{ParamCurve, TrimError, TrimLoop, TrimSegment};
 use crate::geom::bezier::ParamRect;
@@ -28,9 +27,9 @@ const BISECTIONS: usize = 64;
 /// Samples along a piece that is not monotone in the line's coordinate, between which
 /// crossings are bracketed.
 const SAMPLES: usize = 64;
-/// How far inside the line the region's parity is taken, in sizes of the rectangle: far
-/// above the rounding of a crossing point, far below any feature a trim draws.
-const INSIDE: f64 = 1e-9;
+/// Control points this near a side, in sizes of the rectangle, are moved onto it: far
+/// above the rounding of a coordinate, far below any feature a trim draws.
+const SNAP: f64 = 4e-9;
 
 /// One of the rectangle's sides as a half-plane: coordinate `axis` at least `at`
 /// (`keep_above`) or at most `at`.
@@ -60,8 +59,28 @@ pub fn clip_to_rect(loops: &[Vec<Piece>], rect: ParamRect) -> Option<Vec<Vec<Pie
     if inside {
         return None;
     }
-    let nudge = INSIDE * (hi - lo).length();
-    let mut pieces: Vec<Piece> = loops.iter().flatten().cloned().collect();
+    let snap_distance = SNAP * (hi - lo).length();
+    // A loop edge a rounding off the domain's edge (a seam) is put on it, where the side's
+    // intervals stand in for it, rather than left to bound a sliver with the side.
+    let snap = |q: DVec2| {
+        let near = |x: f64, a: f64, b: f64| match () {
+            _ if (x - a).abs() <= snap_distance => a,
+            _ if (x - b).abs() <= snap_distance => b,
+            _ => x,
+        };
+        DVec2::new(near(q.x, lo.x, hi.x), near(q.y, lo.y, hi.y))
+    };
+    let mut pieces: Vec<Piece> = loops
+        .iter()
+        .flatten()
+        .map(|p| {
+            let mut points = p.points.clone();
+            for q in &mut points {
+                *q = (snap(project(*q)) * q.z).extend(q.z);
+            }
+            Piece::new(standard_form(&points, snap(p.start()), snap(p.end())))
+        })
+        .collect();
     for h in [
         HalfPlane {
             axis: 0,
@@ -84,7 +103,7 @@ pub fn clip_to_rect(loops: &[Vec<Piece>], rect: ParamRect) -> Option<Vec<Vec<Pie
             keep_above: false,
         },
     ] {
-        pieces = cut(&pieces, h, nudge);
+        pieces = cut(&pieces, h);
     }
     Some(chain(pieces))
 }
@@ -145,39 +164,48 @@ fn bezier_segment(points: Vec<DVec3>) -> TrimSegment {
     }
 }
 
-/// The pieces bounding the even–odd region of `pieces` within the half-plane `h`.
-fn cut(pieces: &[Piece], h: HalfPlane, nudge: f64) -> Vec<Piece> {
+/// The pieces bounding the even–odd region of `pieces` within the half-plane `h`: their
+/// parts inside it, and the intervals of its line between the points where those parts
+/// end on it, every other one: far along the line it is outside the (bounded) region, and
+/// each part ending on the line crosses its boundary there, so the line is inside the
+/// region's closure exactly after an odd number of such ends. Counting ends, rather than
+/// taking the region's parity beside each interval, keeps every end point met by an even
+/// number of pieces, so the result always chains into closed loops.
+fn cut(pieces: &[Piece], h: HalfPlane) -> Vec<Piece> {
     let mut kept = Vec::new();
-    let mut on_line: Vec<f64> = Vec::new();
+    let mut ends: Vec<f64> = Vec::new();
     let other = 1 - h.axis;
     for piece in pieces {
         for part in split_at_line(piece, h) {
-            let (a, b) = (part.start(), part.end());
-            for q in [a, b] {
+            let along = part.points.iter().all(|&p| project(p)[h.axis] == h.at);
+            if along || h.signed(midpoint(&part)) <= 0.0 {
+                continue;
+            }
+            for q in [part.start(), part.end()] {
                 if q[h.axis] == h.at {
-                    on_line.push(q[other]);
+                    ends.push(q[other]);
                 }
             }
-            let along = part.points.iter().all(|&p| project(p)[h.axis] == h.at);
-            if !along && h.signed(midpoint(&part)) > 0.0 {
-                kept.push(part);
-            }
+            kept.push(part);
         }
     }
-    on_line.sort_by(f64::total_cmp);
-    on_line.dedup();
-    for w in on_line.windows(2) {
-        let mut probe = DVec2::ZERO;
-        probe[h.axis] = h.at + if h.keep_above { nudge } else { -nudge };
-        probe[other] = 0.5 * (w[0] + w[1]);
-        if pieces.iter().filter(|p| crosses_odd(p, probe)).count() % 2 == 1 {
-            let (mut a, mut b) = (DVec2::ZERO, DVec2::ZERO);
-            a[h.axis] = h.at;
-            b[h.axis] = h.at;
-            a[other] = w[0];
-            b[other] = w[1];
-            kept.push(Piece::line(a, b));
+    ends.sort_by(f64::total_cmp);
+    // Ends at one point pair off with each other; an odd count leaves one to the line.
+    let mut odd: Vec<f64> = Vec::new();
+    for x in ends {
+        if odd.last() == Some(&x) {
+            odd.pop();
+        } else {
+            odd.push(x);
         }
+    }
+    for pair in odd.chunks_exact(2) {
+        let (mut a, mut b) = (DVec2::ZERO, DVec2::ZERO);
+        a[h.axis] = h.at;
+        b[h.axis] = h.at;
+        a[other] = pair[0];
+        b[other] = pair[1];
+        kept.push(Piece::line(a, b));
     }
     kept
 }
@@ -295,7 +323,8 @@ fn split_points(points: &[DVec3], t: f64) -> (Vec<DVec3>, Vec<DVec3>) {
 /// where that continues the loop; at a point where several loops touch, any pairing
 /// bounds the same even–odd region).
 fn chain(pieces: Vec<Piece>) -> Vec<Vec<Piece>> {
-    let key = |q: DVec2| (q.x.to_bits(), q.y.to_bits());
+    // `+ 0.0` makes −0 and +0, which compare equal, one key.
+    let key = |q: DVec2| ((q.x + 0.0).to_bits(), (q.y + 0.0).to_bits());
     let mut at: std::collections::HashMap<(u64, u64), Vec<usize>> = Default::default();
     for (i, p) in pieces.iter().enumerate() {
         if p.start() == p.end() && p.points.len() == 2 {
@@ -327,6 +356,10 @@ fn chain(pieces: Vec<Piece>) -> Vec<Vec<Piece>> {
             end = p.end();
             out.push(p);
         }
+        if out.len() < 3 && out.iter().all(|p| p.points.len() == 2) {
+            // Two lines there and back bound nothing.
+            continue;
+        }
         if end != start {
             // Open only if a crossing was found on one side of the line and not on the
             // other, which exact shared points rule out; close it as the loaders would.
@@ -340,6 +373,7 @@ fn chain(pieces: Vec<Piece>) -> Vec<Vec<Piece>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geom::trim::crossing::crosses_odd;
 
     fn parity(loops: &[Vec<Piece>], q: DVec2) -> bool {
         loops.iter().flatten().filter(|p| crosses_odd(p, q)).count() % 2 == 1
@@ -410,6 +444,30 @@ mod tests {
         let pieces = vec![loop_pieces(&TrimLoop::closed(square, false)).unwrap()];
         let clipped = clip_to_rect(&pieces, ParamRect::UNIT).unwrap();
         grid_agrees(&pieces, &clipped, ParamRect::UNIT);
+    }
+
+    #[test]
+    fn an_edge_a_rounding_inside_a_side_goes_onto_it() {
+        // A loop past u = 0 whose right side runs 1e-14 inside u = 1, slanting, as a seam
+        // edge projected by a CAD reader does: one loop comes out (no sliver between the
+        // side and the edge), with the same region.
+        let near = 1.0 - 1e-14;
+        let l = ParamCurve::polygon(&[
+            DVec2::new(-0.5, 0.2),
+            DVec2::new(near, 0.2),
+            DVec2::new(near - 1e-14, 0.8),
+            DVec2::new(-0.5, 0.8),
+            DVec2::new(-0.5, 0.2),
+        ]);
+        let pieces = vec![loop_pieces(&TrimLoop::closed(l, false)).unwrap()];
+        let clipped = clip_to_rect(&pieces, ParamRect::UNIT).unwrap();
+        grid_agrees(&pieces, &clipped, ParamRect::UNIT);
+        assert_eq!(clipped.len(), 1);
+        assert!(
+            clipped[0]
+                .iter()
+                .any(|p| p.points.iter().all(|q| q.x / q.z == 1.0))
+        );
     }
 
     #[test]
