@@ -3,6 +3,7 @@ nearest hits compared (see README.md). Run through run.sh, which provides the Py
 OpenCASCADE (package OCP).
 
     crosscheck.py [FILES or FOLDERS...] [--rays N] [--seed S] [--patchtrace PATH] [--out DIR]
+    crosscheck.py --roundtrip ...   # `patchtrace convert` to IGES and OBJ, read back (roundtrip.py)
 """
 
 import argparse
@@ -15,6 +16,7 @@ import traceback
 
 import check_file  # loads OpenCASCADE once, before any fork
 import occ_model
+import roundtrip
 
 DEFAULT_FOLDER = "../shared/testdata/external/cad"
 COLUMNS = [
@@ -30,14 +32,15 @@ def main():
     if not os.access(args.patchtrace, os.X_OK):
         sys.exit(f"crosscheck: no patchtrace binary at {args.patchtrace} (build it: cargo build --release)")
     os.makedirs(args.out, exist_ok=True)
+    check, table_of = (roundtrip.check, roundtrip.markdown) if args.roundtrip else (check_file.check, markdown)
     start = time.monotonic()
     rows = []
     for path in files:
-        row = check_in_child(path, args)
+        row = check_in_child(path, args, check)
         rows.append(row)
         print(one_line(row), flush=True)
     seconds = time.monotonic() - start
-    table = markdown(rows, seconds, args)
+    table = table_of(rows, seconds, args)
     with open(os.path.join(args.out, "summary.md"), "w") as f:
         f.write(table)
     print()
@@ -71,6 +74,12 @@ def parse_args():
     )
     p.add_argument(
         "--timeout", type=float, default=1800, help="seconds per file for each program (default 1800)"
+    )
+    p.add_argument(
+        "--roundtrip",
+        action="store_true",
+        help="check `patchtrace convert` instead: each file written as IGES and OBJ, the rays through "
+        "patchtrace on all three and through OpenCASCADE on the original and the written IGES",
     )
     p.add_argument(
         "--pt-arg",
@@ -123,7 +132,7 @@ def cad_files(paths):
     return files
 
 
-def check_in_child(path, args):
+def check_in_child(path, args, check):
     """Checks one file in a forked child, so that OpenCASCADE crashing on a file or
     taking too long costs that file's row, not the run. OpenCASCADE's console messages
     go to the file's occ.log."""
@@ -131,7 +140,7 @@ def check_in_child(path, args):
     folder = os.path.join(args.out, os.path.splitext(name)[0])
     ctx = multiprocessing.get_context("fork")
     receive, send = ctx.Pipe(duplex=False)
-    child = ctx.Process(target=_child, args=(send, check_file.check, path, folder, args))
+    child = ctx.Process(target=_child, args=(send, check, path, folder, args))
     child.start()
     send.close()
     row = None
@@ -173,12 +182,9 @@ def _cell(row, key):
 
 
 def one_line(row):
-    counts = " ".join(
-        f"{k} {_cell(row, k)}" for k in ("faces", "rays", "near edge", "holes", "false", "wrong") if k in row
-    )
-    times = " ".join(f"{k} {_cell(row, k)}" for k in ("OCC s", "patchtrace s") if k in row)
+    figures = " ".join(f"{k} {_cell(row, k)}" for k in row if k not in ("file", "written by", "note"))
     writer = row.get("written by") or "(writer unknown)"
-    return "  ".join(x for x in (row["file"], writer, counts, times, row.get("note", "")) if x)
+    return "  ".join(x for x in (row["file"], writer, figures, row.get("note", "")) if x)
 
 
 def markdown(rows, seconds, args):

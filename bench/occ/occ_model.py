@@ -56,7 +56,11 @@ class Model:
 
     def traceable_shape(self):
         """A compound of the faces with a surface: what a ray can be traced against."""
-        return _compound(self.faces[n - 1] for n in self.traceable)
+        return self.shape_of(self.traceable)
+
+    def shape_of(self, numbers):
+        """A compound of the faces with these numbers."""
+        return _compound(self.faces[n - 1] for n in numbers)
 
     def surface_type(self, number):
         kind = BRepAdaptor_Surface(self.faces[number - 1]).GetType()

@@ -32,12 +32,15 @@ class Hit:
 
 
 class Reference:
-    def __init__(self, model, tolerance=DEFAULT_TOLERANCE):
+    def __init__(self, model, tolerance=DEFAULT_TOLERANCE, leave_out=()):
+        """`leave_out`: face numbers not traced (faces on which OpenCASCADE's intersector
+        throws), besides the tessellated-only ones."""
         self.model = model
+        self.traced = [n for n in model.traceable if n not in leave_out]
         self.numbers = ShapeMap()
-        for number in model.traceable:
+        for number in self.traced:
             self.numbers.Add(model.faces[number - 1])
-        self.shape = model.traceable_shape()
+        self.shape = model.shape_of(self.traced)
         self.intersector = IntCurvesFace_ShapeIntersector()
         self.intersector.Load(self.shape, tolerance)
 
@@ -52,7 +55,7 @@ class Reference:
         return Hit(
             t=x.WParameter(i),
             point=x.Pnt(i).Coord(),
-            face=self.model.traceable[index - 1] if index > 0 else 0,
+            face=self.traced[index - 1] if index > 0 else 0,
             u=x.UParameter(i),
             v=x.VParameter(i),
             state=x.State(i).name.removeprefix("TopAbs_"),
