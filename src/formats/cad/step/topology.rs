@@ -90,6 +90,29 @@ impl Piece {
         self.ends = self.ends.map(|e| e + d);
     }
 
+    /// Moves the piece's start (`which` 0) or end (1) onto `to` where the piece is a
+    /// polyline over its whole range (a projected edge), by moving that vertex; false,
+    /// moving nothing, for any other curve.
+    fn move_end(&mut self, which: usize, to: DVec2) -> bool {
+        let c = &mut self.seg.curve;
+        let (d0, d1) = c.domain();
+        if c.degree != 1 || self.seg.t0.min(self.seg.t1) != d0 || self.seg.t0.max(self.seg.t1) != d1
+        {
+            return false;
+        }
+        let curve_end = (which == 1) != self.reversed;
+        let forwards = self.seg.t0 <= self.seg.t1;
+        let k = if curve_end == forwards {
+            c.points.len() - 1
+        } else {
+            0
+        };
+        let w = c.points[k].z;
+        c.points[k] = (to * w).extend(w);
+        self.ends[which] = to;
+        true
+    }
+
     /// Points along the piece, for its extent.
     fn samples(&self) -> impl Iterator<Item = DVec2> + '_ {
         let (t0, t1) = (self.seg.t0, self.seg.t1);
@@ -276,6 +299,37 @@ fn across_range(
     }
     copies
 }
+
+/// Joins `next` to `prev` where their ends differ in the parameters (edges meet at a vertex
+/// in the model): a gap a rounding wide, one point in the model and short beside both
+/// edges (a file's tolerance: two edges' ends projected a hair apart), is closed by moving
+/// a projected edge's end vertex onto the other's, since a chord there would double back
+/// along an edge, a spur of no area that readers of the faces we write make degenerate
+/// faces of; any other gap (a pole or apex, a wider tolerance) is bridged by the returned
+/// chord, so the loop stays closed.
+fn close_gap(dom: &Domain, prev: &mut Piece, next: &mut Piece) -> Option<Piece> {
+    let (end, start) = (prev.end(), next.start());
+    let gap = start.distance(end);
+    if gap <= 1e-9 * (1.0 + end.length()) {
+        return None;
+    }
+    let one_point = dom.point(end).distance(dom.point(start)) <= dom.scale * CHORD_TOLERANCE;
+    let short = |p: &Piece| gap <= SHORT_GAP * p.start().distance(p.end());
+    if one_point
+        && short(prev)
+        && short(next)
+        && !dom.collapsed_u(end)
+        && (next.move_end(0, end) || prev.move_end(1, start))
+    {
+        return None;
+    }
+    Some(Piece::new(TrimSegment::polyline(&[end, start]), false))
+}
+
+/// How short, beside the edges it joins, a gap between two edges' ends must be to be
+/// closed by moving an end rather than bridged: a thousandth leaves a pole's or an apex's
+/// collapsed edge, as long as the edges around it, to its bridge.
+const SHORT_GAP: f64 = 1e-3;
 
 /// The parameter interval `[ta, tb]` of the edge on its 3D curve (increasing) and whether
 /// the edge runs along the curve: vertices located on the curve, periodic curves
@@ -535,17 +589,11 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
                 _ => 0,
             };
             used.insert(e.id, k);
-            let piece = placed(k);
-            // A gap in the domain where the 3D loop is continuous: a pole or apex, or a
-            // file's tolerance; bridge it so the loop stays closed.
-            if let Some(end) = prev_end
-                && piece.start().distance(end) > 1e-9 * (1.0 + end.length())
-            {
-                pieces.push(Piece::new(
-                    TrimSegment::polyline(&[end, piece.start()]),
-                    false,
-                ));
-            }
+            let mut piece = placed(k);
+            let bridge = pieces
+                .last_mut()
+                .and_then(|prev| close_gap(&dom, prev, &mut piece));
+            pieces.extend(bridge);
             pieces.push(piece);
         }
         // On a closed B-spline (surface or profile) the outer loop is placed by whole
@@ -586,8 +634,18 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
                     && gap[1 - axis].abs() <= 1e-9 * (1.0 + last.length())
             })
         });
-        if winds.is_none() && gap.length() > 1e-9 * (1.0 + last.length()) {
-            pieces.push(Piece::new(TrimSegment::polyline(&[last, first]), false));
+        if winds.is_none() {
+            let bridge = match pieces.len() {
+                1 if gap.length() > 1e-9 * (1.0 + last.length()) => {
+                    Some(Piece::new(TrimSegment::polyline(&[last, first]), false))
+                }
+                1 => None,
+                n => {
+                    let (head, tail) = pieces.split_at_mut(n - 1);
+                    close_gap(&dom, &mut tail[0], &mut head[0])
+                }
+            };
+            pieces.extend(bridge);
         }
         let mut lo = f64::INFINITY;
         let mut hi = f64::NEG_INFINITY;
