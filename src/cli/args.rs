@@ -272,7 +272,7 @@ impl std::str::FromStr for TerminationChoice {
 pub const MAX_DEPTH: u8 = 64;
 
 /// How bare mesh files are read, for every command that takes a scene.
-#[derive(Debug, Args, Clone, Copy, Default)]
+#[derive(Debug, Args, Clone, Default)]
 pub struct MeshArgs {
     /// Read a bare mesh file (OBJ polygons, glTF) as the control cage of a subdivision
     /// surface and use its limit surface (boundaries sharp, as OpenSubdiv's EDGE_ONLY).
@@ -281,6 +281,11 @@ pub struct MeshArgs {
     /// in that quad. In a RON scene write `geometry: Subdivision(File("cage.obj"))`.
     #[arg(long, value_enum, value_name = "SCHEME")]
     pub subdivide: Option<SubdivideChoice>,
+    /// USD stages: look through the `Camera` prim at this path (e.g. /World/Cam). Default:
+    /// the stage's first camera in namespace order; a stage without one is framed like
+    /// bare geometry.
+    #[arg(long, value_name = "PRIM_PATH")]
+    pub camera: Option<String>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -293,6 +298,7 @@ impl MeshArgs {
     pub fn load_options(&self) -> crate::formats::LoadOptions {
         crate::formats::LoadOptions {
             subdivide: self.subdivide == Some(SubdivideChoice::CatmullClark),
+            camera: self.camera.clone(),
         }
     }
 }

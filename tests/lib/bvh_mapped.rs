@@ -449,7 +449,10 @@ fn a_bare_file_renders_from_its_bvh_file_without_reading_its_geometry() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("with the prepared patches"));
-    let options = LoadOptions { subdivide: true };
+    let options = LoadOptions {
+        subdivide: true,
+        ..LoadOptions::default()
+    };
     let opened = mapped::map(&bvh).unwrap();
     let (deferred, key) =
         load_scene_keyed(&cage, options, true, Some(opened.cached_scene())).unwrap();
