@@ -336,3 +336,78 @@ fn a_usda_syntax_error_names_its_line_and_column_and_a_missing_camera_is_refused
     let e = load_scene_noted(&testdata("usd/stage.usda"), options).unwrap_err();
     assert!(e.to_string().contains("/World/Cam"), "{e}");
 }
+
+#[test]
+fn import_to_ron_keeps_the_trims_the_shared_instances_and_the_camera() {
+    // A stage of the part layer alone, instanced, with the stage's camera: written
+    // beside a copy of the part so that its reference resolves.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(testdata("usd/part.usda"), dir.path().join("part.usda")).unwrap();
+    let stage = dir.path().join("copies.usda");
+    std::fs::write(
+        &stage,
+        r#"#usda 1.0
+(
+    upAxis = "Z"
+)
+def Xform "A" (instanceable = true references = @./part.usda@)
+{
+    double3 xformOp:translate = (0, 0, 3)
+    uniform token[] xformOpOrder = ["xformOp:translate"]
+}
+def Xform "B" (instanceable = true references = @./part.usda@)
+{
+    double3 xformOp:translate = (2, 0, 3)
+    float xformOp:rotateZ = 90
+    uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateZ"]
+}
+def Camera "Cam"
+{
+    float focalLength = 35
+    double3 xformOp:translate = (0, -12, 4)
+    uniform token[] xformOpOrder = ["xformOp:translate"]
+}
+"#,
+    )
+    .unwrap();
+    let ron = dir.path().join("copies.ron");
+    let o = crate::common::run(&[
+        "import",
+        stage.to_str().unwrap(),
+        "-o",
+        ron.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", crate::common::stderr(&o));
+    let (scene, _) = load_scene_noted(&ron, LoadOptions::default()).unwrap();
+    assert_eq!(scene.objects.len(), 2);
+    assert_eq!(scene.trim_loop_count(), 4, "two loops on each copy");
+    let shared: Vec<_> = scene
+        .objects
+        .iter()
+        .filter_map(|o| match &o.geometry {
+            Geometry::Instance(i) => Some(std::sync::Arc::as_ptr(&i.geometry)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(shared.len(), 2);
+    assert_eq!(shared[0], shared[1], "one shared copy");
+    assert!((scene.camera.eye - DVec3::new(0.0, -12.0, 4.0)).length() < 1e-12);
+    // The default vertical aperture (15.2908) behind a 35 mm lens.
+    let fov = 2.0 * (15.2908f64 / 70.0).atan().to_degrees();
+    assert!(
+        (scene.camera.fov_y - fov).abs() < 1e-6,
+        "{}",
+        scene.camera.fov_y
+    );
+    // Rays through the copies of the .ron hit where the .usda's do.
+    let rays: Vec<_> = [(0.1, 0.1), (1.9, 0.1), (1.5, 0.5), (0.5, 0.5)]
+        .iter()
+        .map(|&(x, y)| (DVec3::new(x, y, 10.0), -DVec3::Z))
+        .collect();
+    let a = trace_hits(&stage, &rays);
+    assert_eq!(a, trace_hits(&ron, &rays));
+    assert!(
+        a[0].is_some() && a[1].is_some() && a[2].is_none() && a[3].is_none(),
+        "{a:?}"
+    );
+}
