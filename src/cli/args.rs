@@ -156,9 +156,10 @@ pub struct TeapotsArgs {
 
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// Scene (.ron) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb, .stl, .igs, .iges,
-    /// .step, .stp). For IGES and STEP files also the units, what was not read (by type),
-    /// surfaces not converted, and the largest error of projected trim curves.
+    /// Scene (.ron, .usda, .usdc, .usdz) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb,
+    /// .stl, .igs, .iges, .step, .stp). For IGES and STEP files also the units, what was
+    /// not read (by type), surfaces not converted, and the largest error of projected trim
+    /// curves.
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
@@ -172,7 +173,7 @@ pub struct InfoArgs {
 
 #[derive(Debug, Args)]
 pub struct ImportArgs {
-    /// Input scene or geometry file (any SCENE input, IGES and STEP included).
+    /// Input scene or geometry file (any SCENE input, IGES, STEP and USD included).
     pub input: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
@@ -373,7 +374,7 @@ pub enum AccelChoice {
 
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// Scene (.ron) or bare geometry.
+    /// Scene (.ron, or a USD stage: .usda, .usdc, .usdz) or bare geometry.
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
@@ -462,7 +463,7 @@ pub struct CompletionsArgs {
 
 #[derive(Debug, Args)]
 pub struct TraceArgs {
-    /// Scene (.ron) or bare geometry.
+    /// Scene (.ron, or a USD stage: .usda, .usdc, .usdz) or bare geometry.
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
@@ -484,7 +485,7 @@ pub struct TraceArgs {
 
 #[derive(Debug, Args)]
 pub struct BvhArgs {
-    /// Scene (.ron) or bare geometry.
+    /// Scene (.ron, or a USD stage: .usda, .usdc, .usdz) or bare geometry.
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
@@ -499,7 +500,7 @@ pub struct BvhArgs {
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("mode").args(["triangles_per_patch", "grid", "tolerance"])))]
 pub struct TessellateArgs {
-    /// Scene (.ron) or bare geometry.
+    /// Scene (.ron, or a USD stage: .usda, .usdc, .usdz) or bare geometry.
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
@@ -574,7 +575,7 @@ pub struct DiffArgs {
 
 #[derive(Debug, Args)]
 pub struct CompareArgs {
-    /// Scene (.ron) or bare geometry.
+    /// Scene (.ron, or a USD stage: .usda, .usdc, .usdz) or bare geometry.
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
@@ -609,7 +610,7 @@ pub struct CompareArgs {
 
 #[derive(Debug, Args)]
 pub struct AccuracyArgs {
-    /// Scene (.ron) or bare geometry.
+    /// Scene (.ron, or a USD stage: .usda, .usdc, .usdz) or bare geometry.
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
