@@ -89,9 +89,12 @@ fn bump() -> Patch {
     }
 }
 
+/// Parameter points (u, v).
+type Samples = Vec<(f64, f64)>;
+
 /// (u, v) samples of the bump's domain kept by its loops (outside the hole of radius
 /// 0.25 about (0.5, 0.5) by a margin) and cut away by them (well inside the hole).
-fn bump_samples() -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
+fn bump_samples() -> (Samples, Samples) {
     let (mut kept, mut cut) = (Vec::new(), Vec::new());
     for a in 1..10 {
         for b in 1..10 {

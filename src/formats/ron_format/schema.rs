@@ -263,6 +263,14 @@ impl TransformDef {
     }
 }
 
+pub(super) fn v3(t: V3) -> DVec3 {
+    DVec3::new(t.0, t.1, t.2)
+}
+
+pub(super) fn c3(t: C3) -> Vec3 {
+    Vec3::new(t.0, t.1, t.2)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -284,12 +292,4 @@ mod tests {
         let back = TransformDef::matrix(&a).to_affine();
         assert!((back.transform_point3(p) - a.transform_point3(p)).length() < 1e-12);
     }
-}
-
-pub(super) fn v3(t: V3) -> DVec3 {
-    DVec3::new(t.0, t.1, t.2)
-}
-
-pub(super) fn c3(t: C3) -> Vec3 {
-    Vec3::new(t.0, t.1, t.2)
 }
