@@ -116,8 +116,14 @@ fn median(v: &[f64]) -> f64 {
 fn main() {
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("testdata/opensubdiv");
     let cage = |file: &str| {
-        let mut s = load_scene_with(&data.join(file), LoadOptions { subdivide: true })
-            .unwrap_or_else(|e| panic!("{file}: {e}"));
+        let mut s = load_scene_with(
+            &data.join(file),
+            LoadOptions {
+                subdivide: true,
+                ..LoadOptions::default()
+            },
+        )
+        .unwrap_or_else(|e| panic!("{file}: {e}"));
         s.camera.width = SIZE;
         s.camera.height = SIZE;
         s

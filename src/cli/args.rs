@@ -156,9 +156,10 @@ pub struct TeapotsArgs {
 
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// Scene (.ron) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb, .stl, .igs, .iges,
-    /// .step, .stp). For IGES and STEP files also the units, what was not read (by type),
-    /// surfaces not converted, and the largest error of projected trim curves.
+    /// Scene (.ron, .usda, .usdc, .usdz) or bare geometry (.bpt, .obj, .pbrt, .gltf, .glb,
+    /// .stl, .igs, .iges, .step, .stp). For IGES and STEP files also the units, what was
+    /// not read (by type), surfaces not converted, and the largest error of projected trim
+    /// curves.
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
@@ -172,7 +173,7 @@ pub struct InfoArgs {
 
 #[derive(Debug, Args)]
 pub struct ImportArgs {
-    /// Input scene or geometry file (any SCENE input, IGES and STEP included).
+    /// Input scene or geometry file (any SCENE input, IGES, STEP and USD included).
     pub input: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
@@ -272,7 +273,7 @@ impl std::str::FromStr for TerminationChoice {
 pub const MAX_DEPTH: u8 = 64;
 
 /// How bare mesh files are read, for every command that takes a scene.
-#[derive(Debug, Args, Clone, Copy, Default)]
+#[derive(Debug, Args, Clone, Default)]
 pub struct MeshArgs {
     /// Read a bare mesh file (OBJ polygons, glTF) as the control cage of a subdivision
     /// surface and use its limit surface (boundaries sharp, as OpenSubdiv's EDGE_ONLY).
@@ -281,6 +282,11 @@ pub struct MeshArgs {
     /// in that quad. In a RON scene write `geometry: Subdivision(File("cage.obj"))`.
     #[arg(long, value_enum, value_name = "SCHEME")]
     pub subdivide: Option<SubdivideChoice>,
+    /// USD stages: look through the `Camera` prim at this path (e.g. /World/Cam). Default:
+    /// the stage's first camera in namespace order; a stage without one is framed like
+    /// bare geometry.
+    #[arg(long, value_name = "PRIM_PATH")]
+    pub camera: Option<String>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -293,6 +299,7 @@ impl MeshArgs {
     pub fn load_options(&self) -> crate::formats::LoadOptions {
         crate::formats::LoadOptions {
             subdivide: self.subdivide == Some(SubdivideChoice::CatmullClark),
+            camera: self.camera.clone(),
         }
     }
 }
@@ -367,7 +374,7 @@ pub enum AccelChoice {
 
 #[derive(Debug, Args)]
 pub struct RenderArgs {
-    /// Scene (.ron) or bare geometry.
+    /// Scene (.ron, or a USD stage: .usda, .usdc, .usdz) or bare geometry.
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
@@ -456,7 +463,7 @@ pub struct CompletionsArgs {
 
 #[derive(Debug, Args)]
 pub struct TraceArgs {
-    /// Scene (.ron) or bare geometry.
+    /// Scene (.ron, or a USD stage: .usda, .usdc, .usdz) or bare geometry.
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
@@ -478,7 +485,7 @@ pub struct TraceArgs {
 
 #[derive(Debug, Args)]
 pub struct BvhArgs {
-    /// Scene (.ron) or bare geometry.
+    /// Scene (.ron, or a USD stage: .usda, .usdc, .usdz) or bare geometry.
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
@@ -493,7 +500,7 @@ pub struct BvhArgs {
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("mode").args(["triangles_per_patch", "grid", "tolerance"])))]
 pub struct TessellateArgs {
-    /// Scene (.ron) or bare geometry.
+    /// Scene (.ron, or a USD stage: .usda, .usdc, .usdz) or bare geometry.
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
@@ -568,7 +575,7 @@ pub struct DiffArgs {
 
 #[derive(Debug, Args)]
 pub struct CompareArgs {
-    /// Scene (.ron) or bare geometry.
+    /// Scene (.ron, or a USD stage: .usda, .usdc, .usdz) or bare geometry.
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,
@@ -603,7 +610,7 @@ pub struct CompareArgs {
 
 #[derive(Debug, Args)]
 pub struct AccuracyArgs {
-    /// Scene (.ron) or bare geometry.
+    /// Scene (.ron, or a USD stage: .usda, .usdc, .usdz) or bare geometry.
     pub scene: PathBuf,
     #[command(flatten)]
     pub mesh: MeshArgs,

@@ -19,6 +19,7 @@ pub enum InputKind {
     Stl,
     Iges,
     Step,
+    Usd,
 }
 
 impl InputKind {
@@ -33,6 +34,7 @@ impl InputKind {
             "stl" => InputKind::Stl,
             "igs" | "iges" => InputKind::Iges,
             "step" | "stp" => InputKind::Step,
+            "usda" | "usdc" | "usdz" | "usd" => InputKind::Usd,
             _ => return None,
         })
     }
@@ -41,7 +43,7 @@ impl InputKind {
 fn unknown_kind(path: &Path) -> LoadError {
     LoadError::invalid(
         path,
-        "unknown file type: expected .ron (scene), .bpt, .obj, .pbrt, .gltf, .glb, .stl, .igs, .iges, .step or .stp",
+        "unknown file type: expected .ron (scene), .usda, .usdc, .usdz, .usd, .bpt, .obj, .pbrt, .gltf, .glb, .stl, .igs, .iges, .step or .stp",
     )
 }
 
@@ -77,7 +79,7 @@ pub fn load_geometry_noted(path: &Path) -> Result<(Geometry, Vec<String>), LoadE
         InputKind::Stl => Ok(Geometry::Mesh(super::stl::read_stl(path)?)),
         InputKind::Iges => return scene::build_geometry(path, iges::read_cad(path)?),
         InputKind::Step => return scene::build_geometry(path, step::read_step(path)?),
-        InputKind::Ron => Err(LoadError::invalid(
+        InputKind::Ron | InputKind::Usd => Err(LoadError::invalid(
             path,
             "a scene cannot be used as geometry; reference its geometry files instead",
         )),
@@ -100,11 +102,11 @@ pub fn default_up(kind: InputKind) -> Axis {
 /// own camera: it is left alone, and `--up` is refused there.
 pub fn reframe(path: &Path, scene: &mut Scene, up: Option<Axis>) -> Result<(), LoadError> {
     let kind = InputKind::of(path).ok_or_else(|| unknown_kind(path))?;
-    if kind == InputKind::Ron {
+    if kind == InputKind::Ron || scene.own_camera {
         return match up {
             Some(_) => Err(LoadError::invalid(
                 path,
-                "--up frames bare geometry; in a scene, set the camera, or give an object `up: Y`",
+                "--up frames bare geometry; in a scene, set the camera, or give an object `up: Y` (a USD stage's camera and upAxis stand)",
             )),
             None => Ok(()),
         };
@@ -142,16 +144,21 @@ pub fn load_subdivision(path: &Path) -> Result<Geometry, LoadError> {
         InputKind::Bpt => Err(refuse("a .bpt file of Bézier patches")),
         InputKind::Pbrt => Err(refuse("a pbrt file")),
         InputKind::Ron => Err(refuse("a RON scene")),
+        InputKind::Usd => Err(refuse(
+            "a USD stage (its meshes are Catmull–Clark cages already)",
+        )),
         InputKind::Iges => Err(refuse("an IGES file")),
         InputKind::Step => Err(refuse("a STEP file")),
     }
 }
 
-/// How bare geometry files are read.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// How bare geometry files and USD stages are read.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct LoadOptions {
     /// Read a bare mesh file as a Catmull–Clark cage (`--subdivide catmull-clark`).
     pub subdivide: bool,
+    /// The path of the USD `Camera` prim to look through (`--camera`).
+    pub camera: Option<String>,
 }
 
 /// Reads a scene: a RON scene file, or bare geometry framed by a default camera and light.
@@ -188,6 +195,7 @@ pub fn load_scene_keyed(
     let mut key = super::source_key::SourceKey::new();
     key.text("bare geometry");
     key.number(u64::from(options.subdivide));
+    key.text(options.camera.as_deref().unwrap_or(""));
     key.file(path)?;
     // With `defer`, the shell the BVH file keeps for these very inputs (its hash is their
     // key) stands in for the file's scene; its geometry comes from the BVH file.
@@ -197,7 +205,7 @@ pub fn load_scene_keyed(
         .and_then(|(_, json)| crate::scene::bare_shell::BareShell::scene_of(json));
     let scene = match kept {
         Some(scene) => scene,
-        None => load_scene_with(path, options)?,
+        None => load_scene_with(path, options.clone())?,
     };
     Ok((scene, key))
 }
@@ -216,6 +224,9 @@ pub fn load_scene_noted(
             ));
         }
         (bare_scene(path, load_subdivision(path)?), Vec::new())
+    } else if InputKind::of(path) == Some(InputKind::Usd) {
+        let read = super::usd::read_usd(path, options.camera.as_deref())?;
+        (read.scene, read.notes)
     } else if let Some(model) = read_cad(path)? {
         let read = scene::build_scene(path, model)?;
         (read.scene, read.notes)

@@ -2,7 +2,7 @@
 //! ([`crate::scene`]): our RON scene, `.bpt` Bézier patch files, Wavefront OBJ (free-form
 //! surfaces with trims, and polygon meshes or Catmull–Clark cages), pbrt-v3
 //! `Shape "nurbs"`, glTF and GLB meshes, STL meshes (ASCII and binary), `trace` ray files, and the CAD exchange formats
-//! IGES and STEP ([`cad`]). Every reader reports errors as `file:line:col: what was
+//! IGES and STEP ([`cad`]), and USD stages ([`usd`]). Every reader reports errors as `file:line:col: what was
 //! expected` (or the byte offset, record or entity of a binary or CAD file); every writer
 //! writes to a temporary name and renames ([`crate::io`]).
 //!
@@ -34,6 +34,7 @@ pub mod sheet;
 pub mod source_key;
 pub mod stl;
 pub mod text;
+pub mod usd;
 pub mod write;
 
 pub use error::{LoadError, ParseError};

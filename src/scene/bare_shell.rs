@@ -26,6 +26,9 @@ pub struct BareShell {
     /// The geometry's bounds, min and max: `--width`, `--height` and `--up` frame the
     /// geometry again ([`crate::formats::load::reframe`]).
     bounds: [[f64; 3]; 2],
+    /// The camera is the file's own (a USD stage's `Camera` prim), not a framing one.
+    #[serde(default)]
+    own_camera: bool,
 }
 
 impl BareShell {
@@ -50,6 +53,7 @@ impl BareShell {
                 .map(|o| (o.name.clone(), o.material))
                 .collect(),
             bounds: [bounds.min.to_array(), bounds.max.to_array()],
+            own_camera: scene.own_camera,
         };
         serde_json::to_vec(&shell).ok()
     }
@@ -87,6 +91,7 @@ impl BareShell {
                 min: DVec3::from_array(shell.bounds[0]),
                 max: DVec3::from_array(shell.bounds[1]),
             }),
+            own_camera: shell.own_camera,
             warnings: Vec::new(),
             unit: None,
         })

@@ -465,6 +465,9 @@ pub struct Scene {
     /// What reading the scene's files left out or tolerated, one line each, for the
     /// command line to print (the library prints nothing).
     pub warnings: Vec<String>,
+    /// The camera is the file's own (a RON scene's, a USD `Camera` prim's), not one
+    /// framing the geometry: new image sizes and `--up` do not move it.
+    pub own_camera: bool,
     /// The length unit of the coordinates, when the file read declared one (a CAD file:
     /// millimetres, and the unit it declared), in words, for writers to state.
     pub unit: Option<String>,
@@ -511,6 +514,7 @@ impl Scene {
             materials: vec![Material::default_named("default")],
             objects,
             unread_bounds: None,
+            own_camera: false,
             warnings: Vec::new(),
             unit: None,
         };

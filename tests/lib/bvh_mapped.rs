@@ -449,10 +449,13 @@ fn a_bare_file_renders_from_its_bvh_file_without_reading_its_geometry() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("with the prepared patches"));
-    let options = LoadOptions { subdivide: true };
+    let options = LoadOptions {
+        subdivide: true,
+        ..LoadOptions::default()
+    };
     let opened = mapped::map(&bvh).unwrap();
     let (deferred, key) =
-        load_scene_keyed(&cage, options, true, Some(opened.cached_scene())).unwrap();
+        load_scene_keyed(&cage, options.clone(), true, Some(opened.cached_scene())).unwrap();
     let (full, full_key) = load_scene_keyed(&cage, options, false, None).unwrap();
     assert_eq!(key, full_key);
     assert_eq!(deferred.objects.len(), full.objects.len());

@@ -25,6 +25,7 @@ mod formats_iges;
 mod formats_mesh;
 mod formats_obj;
 mod formats_pbrt;
+mod formats_usd;
 mod grid_accel;
 mod kernel_newton;
 mod kernel_reference;

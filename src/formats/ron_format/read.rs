@@ -289,6 +289,7 @@ fn build_scene(
         materials,
         objects,
         unread_bounds: None,
+        own_camera: true,
         warnings,
         unit: None,
     })

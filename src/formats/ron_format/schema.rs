@@ -227,6 +227,9 @@ pub enum TransformDef {
     RotateZ(f64),
     /// Degrees about an arbitrary axis.
     Rotate(V3, f64),
+    /// A general affine map as its 3×4 matrix, row by row: `x' = m[0] x + m[1] y + m[2] z
+    /// + m[3]`, and so on (what an imported scene's instance placements are written as).
+    Matrix([f64; 12]),
 }
 
 impl TransformDef {
@@ -241,7 +244,22 @@ impl TransformDef {
             TransformDef::Rotate(a, d) => {
                 DAffine3::from_axis_angle(DVec3::from(a).normalize_or(DVec3::Z), d.to_radians())
             }
+            TransformDef::Matrix(m) => DAffine3 {
+                matrix3: glam::DMat3::from_cols_array(&[
+                    m[0], m[4], m[8], m[1], m[5], m[9], m[2], m[6], m[10],
+                ]),
+                translation: DVec3::new(m[3], m[7], m[11]),
+            },
         }
+    }
+
+    /// An affine map as [`TransformDef::Matrix`].
+    pub fn matrix(a: &DAffine3) -> TransformDef {
+        let (m, t) = (a.matrix3, a.translation);
+        TransformDef::Matrix([
+            m.x_axis.x, m.y_axis.x, m.z_axis.x, t.x, m.x_axis.y, m.y_axis.y, m.z_axis.y, t.y,
+            m.x_axis.z, m.y_axis.z, m.z_axis.z, t.z,
+        ])
     }
 }
 
@@ -251,4 +269,27 @@ pub(super) fn v3(t: V3) -> DVec3 {
 
 pub(super) fn c3(t: C3) -> Vec3 {
     Vec3::new(t.0, t.1, t.2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_matrix_transform_reads_back_as_the_map_it_was_written_from() {
+        let a = DAffine3::from_scale_rotation_translation(
+            DVec3::new(1.0, 2.0, 3.0),
+            glam::DQuat::from_rotation_z(0.3),
+            DVec3::new(4.0, 5.0, 6.0),
+        );
+        let p = DVec3::new(0.5, -1.5, 2.0);
+        // Row 0 of the matrix applied by hand: x' = m0 x + m1 y + m2 z + m3.
+        let TransformDef::Matrix(m) = TransformDef::matrix(&a) else {
+            unreachable!()
+        };
+        let x = m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3];
+        assert!((x - a.transform_point3(p).x).abs() < 1e-12);
+        let back = TransformDef::matrix(&a).to_affine();
+        assert!((back.transform_point3(p) - a.transform_point3(p)).length() < 1e-12);
+    }
 }

@@ -1,5 +1,8 @@
 //! Writing a scene as RON, all geometry inline.
 
+use std::collections::HashMap;
+use std::sync::Arc;
+
 use glam::{DVec3, Vec3};
 
 use super::schema::*;
@@ -8,17 +11,36 @@ use crate::scene::animation::CameraPath;
 use crate::scene::model::*;
 
 /// The serde mirror of a scene with all geometry inline (meshes are not representable
-/// inline and are refused).
+/// inline and are refused). Shared geometry is written once, with the first object that
+/// places it; the others are `Instance`s of that object, each placed by its matrix.
 pub fn scene_to_file(scene: &Scene) -> Result<SceneFile, String> {
     let c = &scene.camera;
     let t = |v: DVec3| (v.x, v.y, v.z);
     let tc = |v: Vec3| (v.x, v.y, v.z);
     let mut objects = Vec::new();
+    let mut written: HashMap<*const Geometry, String> = HashMap::new();
     for o in &scene.objects {
         let limit_patches: Vec<Surface>;
-        // An instance is written as its placed copy.
-        let geometry = o.geometry.resolved();
-        let surfaces = match geometry.as_ref() {
+        let (geometry, transform) = match &o.geometry {
+            Geometry::Instance(i) => {
+                let key = Arc::as_ptr(&i.geometry);
+                let placed = vec![TransformDef::matrix(&i.transform)];
+                if let Some(of) = written.get(&key) {
+                    objects.push(ObjectDef {
+                        name: Some(o.name.clone()),
+                        geometry: GeometryDef::Instance { of: of.clone() },
+                        material: Some(scene.materials[o.material].name.clone()),
+                        up: None,
+                        transform: placed,
+                    });
+                    continue;
+                }
+                written.insert(key, o.name.clone());
+                (i.geometry.as_ref(), placed)
+            }
+            g => (g, Vec::new()),
+        };
+        let surfaces = match geometry {
             Geometry::Surfaces(s) => s,
             // Written as its limit surface's Bézier patches.
             Geometry::Subdivision(s) => {
@@ -38,7 +60,7 @@ pub fn scene_to_file(scene: &Scene) -> Result<SceneFile, String> {
             geometry: GeometryDef::Surfaces(defs),
             material: Some(scene.materials[o.material].name.clone()),
             up: None,
-            transform: Vec::new(),
+            transform,
         });
     }
     Ok(SceneFile {
