@@ -29,8 +29,9 @@ pub enum Command {
     Render(RenderArgs),
     /// Nearest hit per ray from a ray file, as CSV.
     Trace(TraceArgs),
-    /// Tessellate free-form surfaces into a triangle mesh (OBJ, glTF or GLB); trimmed ones
-    /// in their parameter domain, with the gaps between trimmed faces reported.
+    /// Tessellate free-form surfaces into a triangle mesh (OBJ, glTF, GLB or STL); trimmed
+    /// ones in their parameter domain, joined along the edges they share, with the gaps
+    /// between trimmed faces and the distance from the surfaces to the mesh reported.
     Tessellate(TessellateArgs),
     /// Compare two images (PNG or EXR): RMSE, PSNR, MAE, max error, FLIP, coverage.
     Diff(DiffArgs),
@@ -517,8 +518,13 @@ pub struct TessellateArgs {
     /// grid of the larger of U and V (its quads meet turned), at the limit surface.
     #[arg(long, value_name = "U,V", value_parser = parse_grid)]
     pub grid: Option<(u32, u32)>,
-    /// Adaptive, crack-free tessellation with this chord-height tolerance (scene units);
-    /// for a Catmull–Clark cage the finest count any quad needs, on every quad.
+    /// Adaptive, crack-free tessellation with this chord-height tolerance (scene units):
+    /// patch edges and trim curves are sampled until their chords are within it, and
+    /// trimmed faces are refined until the surface is within it at seven probes of every
+    /// triangle (the largest distance found is reported). Trimmed faces whose trim curves
+    /// meet within 10⁻⁴ of the model's size share their samples and vertices there, so a
+    /// closed solid's mesh is closed. For a Catmull–Clark cage the finest count any quad
+    /// needs, on every quad.
     #[arg(long, value_name = "DISTANCE")]
     pub tolerance: Option<f64>,
     /// Print the report as JSON.

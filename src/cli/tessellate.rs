@@ -80,6 +80,11 @@ pub fn run(args: TessellateArgs) -> anyhow::Result<ExitCode> {
                 "trim gaps: largest {:.3e} between {} trimmed faces; {} of {} shared boundary samples open wider than f32 rounding; {} samples with no other face within {:.3e} (free edges)",
                 g.largest, g.faces, g.open_samples, g.shared_samples, g.free_samples, g.radius
             )?;
+            writeln!(
+                out,
+                "surface:   largest distance {:.3e} from the exact surfaces to the mesh (probed in each trimmed face's parameters); shared-edge vertices within {:.3e} of both faces (samples joined within {:.3e})",
+                r.mesh.surface_distance, r.mesh.edge_offset, r.mesh.edge_tolerance
+            )?;
         }
     }
     Ok(ExitCode::SUCCESS)

@@ -124,7 +124,7 @@ pub const MAX_ADAPTIVE_SEGMENTS: usize = 1 << 12;
 /// Interior points per segment at which the chord height is measured. The chord height of
 /// a short polynomial arc peaks near the segment's middle; three points cover the middle
 /// and the quarter points, where an S-shaped cubic segment peaks.
-const CHORD_PROBES: [f64; 3] = [0.25, 0.5, 0.75];
+pub(super) const CHORD_PROBES: [f64; 3] = [0.25, 0.5, 0.75];
 
 /// Doubles the segment count, starting from the degree (a degree-d curve has up to d - 1
 /// inflections, so fewer segments can miss its shape), until every segment's distance from

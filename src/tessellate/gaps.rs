@@ -1,7 +1,8 @@
-//! Gaps between neighbouring trimmed faces. Each trimmed surface is tessellated from its own
-//! loops, and two faces that share a trim curve in the model each have their own copy of it
-//! in their own parameters (CAD exporters fit them separately, to the exporter's
-//! tolerance), so the two meshes meet only approximately. The gap at a boundary sample of
+//! Gaps between neighbouring trimmed faces. Two faces that share a trim curve in the model
+//! each have their own copy of it in their own parameters (CAD exporters fit them
+//! separately, to the exporter's tolerance); where the copies meet within the join distance
+//! the faces share their samples ([`super::shared`]) and the gap is zero, elsewhere the two
+//! meshes meet only approximately. The gap at a boundary sample of
 //! one face is its distance to the nearest boundary polyline of any other face; samples with
 //! no other face within [`NEIGHBOUR_FRACTION`] of the model's size lie on a free edge (or
 //! next to an untrimmed surface) and are counted apart, not mixed into the gap.

@@ -11,11 +11,15 @@
 //! that boundary is stitched by merging the two vertex loops by parameter ([`stitch`]).
 //!
 //! A trimmed surface is triangulated in its parameter domain instead, constrained to its
-//! sampled loops ([`trimmed`]); it is a piece of mesh of its own, and the gaps it leaves
-//! against its neighbouring trimmed faces are measured and reported ([`gaps`]).
+//! sampled loops ([`trimmed`]). Neighbouring trimmed faces are joined along the edges they
+//! share: a boundary sample of one face that lies on the other's trim curve is sampled on
+//! both and placed at one position ([`shared`]), so a closed solid's mesh is closed. What
+//! gaps remain (free edges, edges farther apart than the file's tolerance) are measured
+//! and reported ([`gaps`]), and so is the largest distance of the surface from the mesh.
 
 mod edge;
 pub mod gaps;
+mod shared;
 mod stitch;
 mod subdivision;
 mod trimmed;
@@ -23,11 +27,11 @@ pub mod write;
 
 use std::collections::HashMap;
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use thiserror::Error;
 
 use crate::geom::BezierPatch;
-use crate::scene::model::{Geometry, Object, Scene, SurfaceGeometry, TriangleMesh};
+use crate::scene::model::{Geometry, Object, Scene, Surface, SurfaceGeometry, TriangleMesh};
 
 pub use edge::MAX_ADAPTIVE_SEGMENTS;
 use edge::{EdgeCurve, EdgeKey, Side, segments_for_tolerance};
@@ -90,6 +94,16 @@ pub struct TessellationReport {
     pub vertices: u64,
     pub bytes: u64,
     pub trim_gaps: TrimGaps,
+    /// The largest distance from a trimmed face's exact surface to its triangles, probed at
+    /// seven points of every triangle in the face's parameters (scene units).
+    pub surface_distance: f64,
+    /// The largest distance of a vertex on an edge two trimmed faces share from a face's
+    /// own surface point there (scene units): the vertex is one face's exact point, so this
+    /// is how far apart the file's two faces are along their edges.
+    pub edge_offset: f64,
+    /// The distance within which boundary samples of trimmed faces are taken as one point
+    /// ([`shared::EDGE_FRACTION`] of the model).
+    pub edge_tolerance: f64,
 }
 
 /// Bytes per vertex of the rendered mesh: three `f32` position and three `f32` normal
@@ -105,16 +119,19 @@ impl TessellationReport {
             triangles,
             vertices,
             bytes: vertices * BYTES_PER_VERTEX + triangles * BYTES_PER_TRIANGLE,
-            trim_gaps: TrimGaps::default(),
+            ..TessellationReport::default()
         }
     }
 
-    /// Adds the sizes; gaps are a property of the faces measured together, so they are left
-    /// to the caller that has them all ([`tessellate_scene`]).
+    /// Adds the sizes and takes the larger distances; gaps are a property of the faces
+    /// measured together, so they are left to the caller that has them all
+    /// ([`tessellate_scene`]).
     pub fn add(&mut self, other: &TessellationReport) {
         self.triangles += other.triangles;
         self.vertices += other.vertices;
         self.bytes += other.bytes;
+        self.surface_distance = self.surface_distance.max(other.surface_distance);
+        self.edge_offset = self.edge_offset.max(other.edge_offset);
     }
 }
 
@@ -154,17 +171,19 @@ pub fn tessellate_scene_with(
     let mut report = TessellationReport::default();
     let mut objects = Vec::with_capacity(scene.objects.len());
     let mut boundaries = Vec::new();
-    for object in &scene.objects {
+    let (mut splits, edge_tolerance) = split_and_join(&scene.objects, mode)?;
+    for (object, split) in scene.objects.iter().zip(&mut splits) {
         let budget = Budget {
             object: &object.name,
             triangles: MAX_TRIANGLES.saturating_sub(report.triangles),
         };
-        let (o, r, b) = object_within(object, mode, budget, patch_done)?;
+        let (o, r, b) = object_within(object, split.take(), mode, budget, patch_done)?;
         report.add(&r);
         objects.push(o);
         boundaries.extend(b);
     }
     report.trim_gaps = gaps::measure(&boundaries);
+    report.edge_tolerance = edge_tolerance;
     Ok((
         Scene {
             objects,
@@ -185,9 +204,120 @@ pub fn tessellate_object(
         object: &object.name,
         triangles: MAX_TRIANGLES,
     };
-    let (object, mut report, boundaries) = object_within(object, mode, budget, &mut || {})?;
+    let (mut splits, edge_tolerance) = split_and_join(std::slice::from_ref(object), mode)?;
+    let (object, mut report, boundaries) =
+        object_within(object, splits[0].take(), mode, budget, &mut || {})?;
     report.trim_gaps = gaps::measure(&boundaries);
+    report.edge_tolerance = edge_tolerance;
     Ok((object, report))
+}
+
+/// One trimmed surface's share of a tessellation, with each vertex's parameters in the
+/// surface's own domain.
+#[derive(Clone, Debug)]
+pub struct TrimmedMesh {
+    /// The surface's index in the slice given to [`tessellate_trimmed`].
+    pub surface: usize,
+    pub mesh: TriangleMesh,
+    pub params: Vec<DVec2>,
+}
+
+/// The trimmed surfaces among `surfaces` tessellated as [`tessellate_scene`] does them
+/// (joined along the edges they share), each with its vertices' parameters, so that the
+/// mesh can be checked against the exact surfaces; the report has the distances, not the
+/// gaps.
+pub fn tessellate_trimmed(
+    surfaces: &[Surface],
+    mode: TessellationMode,
+) -> Result<(Vec<TrimmedMesh>, TessellationReport), TessellateError> {
+    let plan = Plan::new(mode)?;
+    let (mut index, mut faces) = (Vec::new(), Vec::new());
+    for (k, s) in surfaces.iter().enumerate() {
+        if let Some(region) = s.trim_region().ok().flatten()
+            && let Some(face) = trimmed::Face::new(s, region, plan)
+        {
+            index.push(k);
+            faces.push(face);
+        }
+    }
+    let mut report = TessellationReport {
+        edge_tolerance: shared::join(&mut faces),
+        ..TessellationReport::default()
+    };
+    let mut out = Vec::with_capacity(faces.len());
+    for (n, (face, surface)) in faces.iter().zip(index).enumerate() {
+        let budget = Budget {
+            object: "",
+            triangles: MAX_TRIANGLES.saturating_sub(report.triangles),
+        };
+        let face = face.tessellate(plan, budget, n as u32)?;
+        report.add(&TessellationReport {
+            surface_distance: face.deviation,
+            edge_offset: face.offset,
+            ..TessellationReport::of(&face.mesh)
+        });
+        out.push(TrimmedMesh {
+            surface,
+            mesh: face.mesh,
+            params: face.params,
+        });
+    }
+    Ok((out, report))
+}
+
+/// An object's free-form surfaces: the Bézier patches of its untrimmed ones and its
+/// trimmed faces, ready to be triangulated.
+struct Split {
+    plain: Vec<BezierPatch>,
+    faces: Vec<trimmed::Face>,
+}
+
+/// Each object's surfaces split (`None` for other geometry), with the trimmed faces of all
+/// objects joined along the edges they share ([`shared`]), and the joining distance.
+fn split_and_join(
+    objects: &[Object],
+    mode: TessellationMode,
+) -> Result<(Vec<Option<Split>>, f64), TessellateError> {
+    let mut splits = Vec::with_capacity(objects.len());
+    for object in objects {
+        // An instance is tessellated as its placed copy.
+        let geometry = object.geometry.resolved();
+        let Geometry::Surfaces(surfaces) = geometry.as_ref() else {
+            splits.push(None);
+            continue;
+        };
+        let plan = Plan::new(mode)?;
+        let mut split = Split {
+            plain: Vec::new(),
+            faces: Vec::new(),
+        };
+        for s in surfaces {
+            // Loops that fail to convert were refused at load; were one to get here, the
+            // surface is drawn untrimmed, as the renderer does.
+            match s.trim_region().ok().flatten() {
+                Some(region) => split.faces.extend(trimmed::Face::new(s, region, plan)),
+                None => match &s.geometry {
+                    SurfaceGeometry::Bezier(p) => split.plain.push(p.clone()),
+                    SurfaceGeometry::Nurbs(n) => split.plain.extend(n.to_bezier_patches()),
+                },
+            }
+        }
+        splits.push(Some(split));
+    }
+    // The faces of all objects are joined together (a part's faces may be split over
+    // objects by colour), then handed back to their objects.
+    let mut faces: Vec<trimmed::Face> = Vec::new();
+    let mut counts = Vec::with_capacity(splits.len());
+    for split in splits.iter_mut().flatten() {
+        counts.push(split.faces.len());
+        faces.append(&mut split.faces);
+    }
+    let tolerance = shared::join(&mut faces);
+    let mut faces = faces.into_iter();
+    for (split, n) in splits.iter_mut().flatten().zip(counts) {
+        split.faces = faces.by_ref().take(n).collect();
+    }
+    Ok((splits, tolerance))
 }
 
 /// A trimmed face's boundary polylines in space.
@@ -202,48 +332,47 @@ struct Budget<'a> {
 }
 
 /// [`tessellate_object`] within `budget`, without the gap measure, with the boundaries of
-/// its trimmed faces.
+/// its trimmed faces; `split` is the object's surfaces, split by [`split_and_join`].
 fn object_within(
     object: &Object,
+    split: Option<Split>,
     mode: TessellationMode,
     budget: Budget,
     patch_done: &mut dyn FnMut(),
 ) -> Result<(Object, TessellationReport, Vec<FaceBoundary>), TessellateError> {
     let mut boundaries = Vec::new();
+    let (mut surface_distance, mut edge_offset) = (0.0f64, 0.0f64);
     // An instance is tessellated as its placed copy.
     let geometry = object.geometry.resolved();
-    let mesh = match geometry.as_ref() {
-        Geometry::Mesh(m) => m.clone(),
-        Geometry::Surfaces(surfaces) => {
+    let mesh = match (split, geometry.as_ref()) {
+        (Some(split), _) => {
             let plan = Plan::new(mode)?;
-            let mut plain = Vec::new();
-            let mut trimmed = Vec::new();
-            for s in surfaces {
-                // Loops that fail to convert were refused at load; were one to get here, the
-                // surface is drawn untrimmed, as the renderer does.
-                match s.trim_region().ok().flatten() {
-                    Some(region) => trimmed.push((s, region)),
-                    None => match &s.geometry {
-                        SurfaceGeometry::Bezier(p) => plain.push(p.clone()),
-                        SurfaceGeometry::Nurbs(n) => plain.extend(n.to_bezier_patches()),
-                    },
-                }
-            }
-            let mut mesh = patches_within(&plain, mode, budget, patch_done)?.mesh;
-            for (s, region) in trimmed {
-                let face = trimmed::tessellate_trimmed(s, &region, plan)?;
+            let mut mesh = patches_within(&split.plain, mode, budget, patch_done)?.mesh;
+            for (k, face) in split.faces.iter().enumerate() {
+                let budget = Budget {
+                    triangles: budget.triangles.saturating_sub(mesh.indices.len() as u64),
+                    ..budget
+                };
+                let face = face.tessellate(plan, budget, k as u32)?;
                 append(&mut mesh, face.mesh)?;
                 boundaries.push(face.boundary);
+                surface_distance = surface_distance.max(face.deviation);
+                edge_offset = edge_offset.max(face.offset);
                 patch_done();
             }
             mesh
         }
-        Geometry::Subdivision(surface) => {
+        (None, Geometry::Subdivision(surface)) => {
             subdivision::tessellate_surface(surface, Plan::new(mode)?, budget, patch_done)?
         }
-        Geometry::Instance(_) => tessellate_patches(&geometry.bezier_patches(), mode)?.mesh,
+        (None, Geometry::Mesh(m)) => m.clone(),
+        (None, _) => tessellate_patches(&geometry.bezier_patches(), mode)?.mesh,
     };
-    let report = TessellationReport::of(&mesh);
+    let report = TessellationReport {
+        surface_distance,
+        edge_offset,
+        ..TessellationReport::of(&mesh)
+    };
     Ok((
         Object {
             geometry: Geometry::Mesh(mesh),

@@ -5,27 +5,43 @@
 //!
 //! The points are the patch grid points the trim keeps (the same grids as untrimmed patches)
 //! and the samples of every loop piece; consecutive samples of a piece are constraint edges,
-//! so no triangle crosses the sampled loops. A triangle is kept where its centre is inside
-//! the region by the exact even–odd test ([`TrimRegion::contains`]), which sorts out outer
-//! loops, holes and islands with no orientation or nesting information.
+//! so no triangle crosses the sampled loops. Which triangles are kept is decided against the
+//! sampled loops themselves, the polygon the mesh's boundary is made of: by parity across
+//! constraint edges, flooding from the triangulation's hull (the even–odd rule, so outer
+//! loops, holes and islands need no orientation or nesting information). Where that polygon
+//! is not closed or a constraint could not be added (loops that touch or cross), the exact
+//! even–odd test of each triangle's centre against the loops decides
+//! ([`TrimRegion::contains`]).
 //!
-//! Loops are sampled to the tessellation's own accuracy: in adaptive mode until the chord
-//! height of the loop's image on the surface is within the tolerance (as for patch edges);
-//! with a fixed grid, until no loop segment spans more than a grid cell in either parameter.
-//! Each trimmed surface is its own piece of mesh: its boundary is sampled from its own
-//! loops, so neighbouring trimmed faces leave gaps, measured by [`super::gaps`].
+//! Loops are sampled to the tessellation's own accuracy: in adaptive mode until both the
+//! loop's image on the surface and the surface along each chord in the parameter plane lie
+//! within the tolerance of the chord in space; with a fixed grid, until no loop segment
+//! spans more than a grid cell in either parameter. Samples that another face shares are
+//! added by [`super::shared`] before the face is triangulated, with the vertex position
+//! both faces use.
+//!
+//! The distance from the surface to the mesh is measured, not assumed: at
+//! [`PROBES`] of every triangle the surface is evaluated in `f64` at the interpolated
+//! parameters and its distance to the triangle taken. In adaptive mode a triangle whose
+//! probe is farther than the tolerance gets that probe as a new point (Delaunay refinement,
+//! Ruppert, "A Delaunay refinement algorithm for quality 2-dimensional mesh generation",
+//! J. Algorithms 18, 1995, with the chordal error in place of the angle criterion), until
+//! every probe off the boundary is within it.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet, VecDeque};
 
 use glam::{DVec2, DVec3, DVec4};
-use spade::{ConstrainedDelaunayTriangulation, Point2, Triangulation};
+use spade::handles::{DirectedEdgeHandle, FixedFaceHandle, FixedVertexHandle, InnerTag};
+use spade::{
+    CdtEdge, ConstrainedDelaunayTriangulation, Point2, PositionInTriangulation, Triangulation,
+};
 
-use super::edge::{EdgeCurve, Side, segments_for_tolerance, segments_until};
-use super::{Plan, TessellateError};
+use super::edge::{CHORD_PROBES, EdgeCurve, Side, segments_until};
+use super::{Budget, MAX_TRIANGLES, Plan, TessellateError};
 use crate::geom::BezierPatch;
 use crate::geom::bezier::{ParamRect, de_casteljau_point, dehomogenize};
-use crate::geom::trim::pieces::Piece;
-use crate::geom::trim::{AxisMap, Coverage, TrimRegion};
+use crate::geom::segment::{distance_to_segment, distance_to_triangle};
+use crate::geom::trim::{Coverage, TrimRegion};
 use crate::scene::model::{Surface, TriangleMesh};
 
 /// A trimmed surface triangulated in its (NURBS) parameters: `params[k]` is vertex k,
@@ -36,13 +52,45 @@ pub(super) struct ParamTriangulation {
     pub params: Vec<DVec2>,
     pub triangles: Vec<[u32; 3]>,
     pub boundary: Vec<Vec<u32>>,
+    /// The largest distance from the surface to the mesh at the probes.
+    pub deviation: f64,
 }
 
-/// A trimmed surface's mesh and its boundary polylines in space (one per loop piece).
+/// A trimmed surface's mesh, its boundary polylines in space (one per loop piece), the
+/// largest distance from the surface to the mesh at the probes, and the largest distance
+/// of a boundary vertex from the face's own surface point (nonzero where the vertex is the
+/// point of the neighbouring face it is shared with).
 pub(super) struct TrimmedFace {
     pub mesh: TriangleMesh,
+    /// Each mesh vertex's parameters in the surface's own domain.
+    pub params: Vec<DVec2>,
     pub boundary: Vec<Vec<DVec3>>,
+    pub deviation: f64,
+    pub offset: f64,
 }
+
+/// Barycentric points at which a triangle's distance from the surface is probed: its
+/// centroid, the three points halfway from the centroid to a corner, and the edge
+/// midpoints (where the chord of a curved edge is farthest from it).
+const PROBES: [[f64; 3]; 7] = [
+    [1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0],
+    [2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0],
+    [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0],
+    [1.0 / 6.0, 1.0 / 6.0, 2.0 / 3.0],
+    [0.5, 0.5, 0.0],
+    [0.0, 0.5, 0.5],
+    [0.5, 0.0, 0.5],
+];
+
+/// How near a grid point may come to a boundary edge, as a fraction of its patch's grid
+/// cell in each parameter: a quarter cell keeps the triangles between the loops and the
+/// grid no thinner than a quarter of the grid's own.
+const BOUNDARY_CLEARANCE: f64 = 0.25;
+
+/// Most rounds of refinement; each round adds at most one point per triangle that is too
+/// far from the surface, so the count at most doubles per round and the tolerance, once
+/// the loops' samples are fine enough, is met in a few.
+const MAX_REFINE_ROUNDS: usize = 16;
 
 /// A surface's Bézier patches located by parameter: the sorted span breaks in u and v and,
 /// per span cell, the patch over it.
@@ -124,7 +172,7 @@ impl Patches {
 
     fn eval(&self, p: DVec2) -> DVec3 {
         let (patch, s, t) = self.at(p);
-        patch.eval(s, t)
+        patch.eval(s, t) + DVec3::ZERO
     }
 }
 
@@ -140,84 +188,372 @@ fn grid(patch: &BezierPatch, plan: Plan) -> (usize, usize) {
     (gu, gv)
 }
 
-/// The point of a loop piece at `t`; the ends are the end points themselves, so pieces
-/// that meet share their sample bit for bit.
-fn piece_point(piece: &Piece, t: f64) -> DVec2 {
-    if t == 0.0 {
-        return piece.start();
-    }
-    if t == 1.0 {
-        return piece.end();
-    }
-    let h: Vec<DVec4> = piece
-        .points
-        .iter()
-        .map(|q| DVec4::new(q.x, q.y, 0.0, q.z))
-        .collect();
-    dehomogenize(de_casteljau_point(&h, t)).truncate()
+/// One sample of a loop piece.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Sample {
+    /// The piece's own parameter, in [0, 1].
+    pub t: f64,
+    /// The surface's parameters there.
+    pub param: DVec2,
+    /// The face's surface at `param`.
+    pub point: DVec3,
+    /// The mesh vertex: `point`, or the point of the face this sample is shared with.
+    pub position: DVec3,
 }
 
-/// A trim-space point in the surface's own parameters.
-fn to_surface(maps: &[AxisMap; 2], p: DVec2) -> DVec2 {
-    DVec2::new(maps[0].invert(p.x), maps[1].invert(p.y))
+/// A trimmed surface ready to be triangulated: its patches, its loops (as rational Bézier
+/// pieces in trim parameters), the grid points the trim keeps, and per piece its samples in
+/// order of the piece's parameter.
+pub(super) struct Face {
+    patches: Patches,
+    region: TrimRegion,
+    /// Each piece's homogeneous points `(w u, w v, 0, w)`, for de Casteljau.
+    curves: Vec<Vec<DVec4>>,
+    /// Per piece, the trim coordinates (u, v) it keeps constant, if any.
+    lines: Vec<[Option<f64>; 2]>,
+    grid: Vec<DVec2>,
+    pub samples: Vec<Vec<Sample>>,
 }
 
-/// Triangulates the surface of `patches`, whose loops make `region`, in its parameter
-/// domain.
-fn triangulate_patches(
-    patches: &Patches,
-    region: &TrimRegion,
-    plan: Plan,
-) -> Result<ParamTriangulation, TessellateError> {
-    let mut points = Points::default();
-    for (patch, coverage) in &patches.list {
-        if *coverage == Coverage::Outside {
-            continue;
-        }
-        let (gu, gv) = grid(patch, plan);
-        let d = patch.domain();
-        for j in 0..=gv {
-            for i in 0..=gu {
-                let (s, t) = (i as f64 / gu as f64, j as f64 / gv as f64);
-                let keep = match coverage {
-                    Coverage::Partial(trim) => trim.keeps(s, t),
-                    _ => true,
-                };
-                if keep {
-                    let (u, v) = d.to_parent(s, t);
-                    points.add(DVec2::new(u, v));
+impl Face {
+    /// The face of `surface` cut by `region`, its loops sampled for `plan`; `None` when the
+    /// surface has no patches.
+    pub fn new(surface: &Surface, region: TrimRegion, plan: Plan) -> Option<Face> {
+        let patches = Patches::of(surface, plan)?;
+        let mut grid_points = Vec::new();
+        for (patch, coverage) in &patches.list {
+            if *coverage == Coverage::Outside {
+                continue;
+            }
+            let (gu, gv) = grid(patch, plan);
+            let d = patch.domain();
+            for j in 0..=gv {
+                for i in 0..=gu {
+                    let (s, t) = (i as f64 / gu as f64, j as f64 / gv as f64);
+                    let keep = match coverage {
+                        Coverage::Partial(trim) => trim.keeps(s, t),
+                        _ => true,
+                    };
+                    if keep {
+                        let (u, v) = d.to_parent(s, t);
+                        grid_points.push(DVec2::new(u, v));
+                    }
                 }
             }
         }
+        let curves = region
+            .pieces()
+            .iter()
+            .map(|piece| {
+                piece
+                    .points
+                    .iter()
+                    .map(|q| DVec4::new(q.x, q.y, 0.0, q.z))
+                    .collect()
+            })
+            .collect();
+        let lines = region
+            .pieces()
+            .iter()
+            .map(|piece| {
+                let axis = |a: usize| {
+                    let x = piece.points[0][a] / piece.points[0].z;
+                    piece
+                        .points
+                        .iter()
+                        .all(|q| (q[a] / q.z).to_bits() == x.to_bits())
+                        .then_some(x)
+                };
+                [axis(0), axis(1)]
+            })
+            .collect();
+        let mut face = Face {
+            patches,
+            region,
+            curves,
+            lines,
+            grid: grid_points,
+            samples: Vec::new(),
+        };
+        face.samples = (0..face.curves.len())
+            .map(|k| face.sample_piece(k, plan))
+            .collect();
+        Some(face)
     }
-    let maps = region.maps();
-    let mut boundary = Vec::with_capacity(region.pieces().len());
-    for piece in region.pieces() {
-        let at = |t: f64| to_surface(maps, piece_point(piece, t));
-        let degree = piece.points.len() - 1;
+
+    /// The sample of piece `k` at `t`. The ends are the piece's end points themselves, so
+    /// pieces that meet share their sample bit for bit.
+    pub fn sample(&self, k: usize, t: f64) -> Sample {
+        let curve = &self.curves[k];
+        let h = if t == 0.0 {
+            curve[0]
+        } else if t == 1.0 {
+            curve[curve.len() - 1]
+        } else {
+            de_casteljau_point(curve, t)
+        };
+        // A piece along a parameter line stays exactly on it: de Casteljau's rounding would
+        // make its samples zigzag about the line by an ulp, and the triangulation would
+        // keep the slivers between them, which the surface's parametrization can make wide
+        // in space (a plane's polar parameters at an arc).
+        let q = dehomogenize(h).truncate();
+        let [lu, lv] = self.lines[k];
+        let q = DVec2::new(lu.unwrap_or(q.x), lv.unwrap_or(q.y));
+        let maps = self.region.maps();
+        let param = DVec2::new(maps[0].invert(q.x), maps[1].invert(q.y));
+        let point = self.patches.eval(param);
+        Sample {
+            t,
+            param,
+            point,
+            position: point,
+        }
+    }
+
+    fn sample_piece(&self, k: usize, plan: Plan) -> Vec<Sample> {
+        let degree = self.curves[k].len() - 1;
         let n = match plan {
-            Plan::Adaptive { tolerance } => {
-                segments_for_tolerance(&|t| patches.eval(at(t)), degree, tolerance)
-            }
+            // The boundary edges are constraints that refinement may not split (the
+            // neighbouring face shares them), so they are made fine enough here: the curve
+            // and the surface across the chord in the parameter plane both stay near the
+            // chord in space.
+            Plan::Adaptive { tolerance } => segments_until(degree, &|t0, t1| {
+                let (a, b) = (self.sample(k, t0), self.sample(k, t1));
+                CHORD_PROBES.iter().all(|&f| {
+                    let along = self.sample(k, t0 + (t1 - t0) * f).point;
+                    let across = self.patches.eval(a.param.lerp(b.param, f));
+                    distance_to_segment(along, a.point, b.point) <= tolerance
+                        && distance_to_segment(across, a.point, b.point) <= tolerance
+                })
+            }),
             // No segment longer than the grid cell of the patch where it starts.
             Plan::Uniform { .. } => segments_until(degree, &|t0, t1| {
-                let (a, b) = (at(t0), at(t1));
-                let cell = patches.cells[patches.index(a)];
+                let (a, b) = (self.sample(k, t0).param, self.sample(k, t1).param);
+                let cell = self.patches.cells[self.patches.index(a)];
                 let d = (b - a).abs();
                 d.x <= cell.x && d.y <= cell.y
             }),
         };
-        let samples: Vec<u32> = (0..=n)
-            .map(|k| points.add(at(k as f64 / n as f64)))
-            .collect();
-        boundary.push(samples);
+        (0..=n)
+            .map(|i| self.sample(k, i as f64 / n as f64))
+            .collect()
     }
-    let triangles = constrained_delaunay(&points.list, &boundary, region)?;
-    Ok(ParamTriangulation {
-        params: points.list,
-        triangles,
-        boundary,
-    })
+
+    /// Triangulates the face in its parameter domain, refining in adaptive mode until the
+    /// surface is within the tolerance of the mesh at every probe off the boundary, with
+    /// each point's position in space; more triangles than `budget` allows is an error
+    /// naming the face by its number `face`.
+    pub fn triangulate(
+        &self,
+        plan: Plan,
+        budget: Budget,
+        face: u32,
+    ) -> Result<(ParamTriangulation, Vec<DVec3>), TessellateError> {
+        // The loops first, as constraints; then the grid points clear of them.
+        let mut points = Points::default();
+        let boundary: Vec<Vec<u32>> = self
+            .samples
+            .iter()
+            .map(|line| line.iter().map(|s| points.add(s.param)).collect())
+            .collect();
+        let mut positions = vec![DVec3::ZERO; points.list.len()];
+        for (line, samples) in boundary.iter().zip(&self.samples) {
+            for (&i, s) in line.iter().zip(samples) {
+                positions[i as usize] = s.position;
+            }
+        }
+        let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
+        for p in &points.list {
+            insert(&mut cdt, *p)?;
+        }
+        let mut constraints = HashSet::new();
+        let mut all_added = true;
+        for line in &boundary {
+            for w in line.windows(2).filter(|w| w[0] != w[1]) {
+                let (a, b) = (vertex(w[0]), vertex(w[1]));
+                if !cdt.exists_constraint(a, b) && cdt.try_add_constraint(a, b).is_empty() {
+                    all_added = false;
+                }
+                constraints.insert((w[0].min(w[1]), w[0].max(w[1])));
+            }
+        }
+        for &q in &self.grid {
+            if self.clear_of_boundary(&cdt, q) {
+                let before = points.list.len();
+                if points.add(q) as usize == before {
+                    positions.push(self.patches.eval(q));
+                    insert(&mut cdt, q)?;
+                }
+            }
+        }
+        let by_parity = all_added && loops_close(&boundary);
+        let mut rounds = 0;
+        loop {
+            let triangles = if by_parity {
+                kept_by_parity(&cdt, self.region.outer_is_domain())
+            } else {
+                kept_by_centre(&cdt, &points.list, &self.region)
+            };
+            let count = triangles.len() as u64;
+            if count > budget.triangles {
+                return Err(TessellateError::Budget {
+                    object: budget.object.to_string(),
+                    patch: face,
+                    triangles: count + (MAX_TRIANGLES - budget.triangles),
+                    budget: MAX_TRIANGLES,
+                });
+            }
+            let mut deviation = 0.0f64;
+            let mut refine = Vec::new();
+            for t in &triangles {
+                let (d, worst) = self.probe(t, &points.list, &positions, &constraints);
+                deviation = deviation.max(d);
+                if let (Plan::Adaptive { tolerance }, Some((far, q))) = (plan, worst)
+                    && far > tolerance
+                {
+                    refine.push(q);
+                }
+            }
+            if refine.is_empty() || rounds == MAX_REFINE_ROUNDS {
+                return Ok((
+                    ParamTriangulation {
+                        params: points.list,
+                        triangles,
+                        boundary,
+                        deviation,
+                    },
+                    positions,
+                ));
+            }
+            for q in refine {
+                let before = points.list.len();
+                let i = points.add(q);
+                if i as usize == before {
+                    positions.push(self.patches.eval(q));
+                    insert(&mut cdt, q)?;
+                }
+            }
+            rounds += 1;
+        }
+    }
+
+    /// Whether grid point `q` is clear of the loops: not on a boundary edge (which would
+    /// split it, and the neighbouring face would not have the split) and not within
+    /// [`BOUNDARY_CLEARANCE`] of its patch's grid cell of one (which would make a sliver).
+    /// The edges looked at are those of the triangle (or two) the point falls in, which
+    /// are the nearest ones for a point that near.
+    fn clear_of_boundary(&self, cdt: &Cdt, q: DVec2) -> bool {
+        let cell = self.patches.cells[self.patches.index(q)];
+        let scale = |p: Point2<f64>| DVec3::new(p.x / cell.x, p.y / cell.y, 0.0);
+        let at = DVec3::new(q.x / cell.x, q.y / cell.y, 0.0);
+        let near = |e: DirectedEdgeHandle<Point2<f64>, (), CdtEdge<()>, ()>| {
+            let [a, b] = e.positions();
+            e.is_constraint_edge()
+                && distance_to_segment(at, scale(a), scale(b)) < BOUNDARY_CLEARANCE
+        };
+        let face_clear = |f: FixedFaceHandle<InnerTag>| {
+            cdt.face(f).adjacent_edges().into_iter().all(|e| !near(e))
+        };
+        match cdt.locate(Point2::new(q.x, q.y)) {
+            PositionInTriangulation::OnVertex(_) => false,
+            PositionInTriangulation::OnEdge(e) => {
+                let e = cdt.directed_edge(e);
+                !e.is_constraint_edge()
+                    && [e.face(), e.rev().face()]
+                        .into_iter()
+                        .filter_map(|f| f.as_inner())
+                        .all(|f| face_clear(f.fix()))
+            }
+            PositionInTriangulation::OnFace(f) => face_clear(f),
+            PositionInTriangulation::OutsideOfConvexHull(_)
+            | PositionInTriangulation::NoTriangulation => true,
+        }
+    }
+
+    /// The largest distance from the surface to triangle `t` at the probes, and the
+    /// farthest probe that may become a point (not on a boundary edge) with its distance.
+    fn probe(
+        &self,
+        t: &[u32; 3],
+        params: &[DVec2],
+        positions: &[DVec3],
+        constraints: &HashSet<(u32, u32)>,
+    ) -> (f64, Option<(f64, DVec2)>) {
+        let [a, b, c] = t.map(|i| params[i as usize]);
+        let [pa, pb, pc] = t.map(|i| positions[i as usize]);
+        let mut largest = 0.0f64;
+        let mut worst: Option<(f64, DVec2)> = None;
+        for w in PROBES {
+            let q = a * w[0] + b * w[1] + c * w[2];
+            let d = distance_to_triangle(self.patches.eval(q), pa, pb, pc);
+            largest = largest.max(d);
+            // An edge probe lies on the edge between the two corners it weighs.
+            let on_boundary = match w.iter().position(|&x| x == 0.0) {
+                Some(k) => {
+                    let (i, j) = (t[(k + 1) % 3], t[(k + 2) % 3]);
+                    constraints.contains(&(i.min(j), i.max(j)))
+                }
+                None => false,
+            };
+            if !on_boundary && worst.is_none_or(|(far, _)| d > far) {
+                worst = Some((d, q));
+            }
+        }
+        (largest, worst)
+    }
+
+    /// The face's mesh (boundary vertices at their samples' shared positions, the rest on
+    /// the exact surface, every normal the face's own) and its boundary in space.
+    pub fn tessellate(
+        &self,
+        plan: Plan,
+        budget: Budget,
+        face: u32,
+    ) -> Result<TrimmedFace, TessellateError> {
+        let (tri, positions) = self.triangulate(plan, budget, face)?;
+        let mut mesh = TriangleMesh::default();
+        let mut params = Vec::new();
+        let mut index = vec![u32::MAX; tri.params.len()];
+        for t in &tri.triangles {
+            // Two corners at one position (samples of one face joined to one point of its
+            // neighbour) make no triangle.
+            let [a, b, c] = t.map(|i| positions[i as usize]);
+            if a == b || b == c || c == a {
+                continue;
+            }
+            let mut out = [0u32; 3];
+            for (k, &i) in t.iter().enumerate() {
+                let slot = &mut index[i as usize];
+                if *slot == u32::MAX {
+                    let (patch, s, w) = self.patches.at(tri.params[i as usize]);
+                    *slot = mesh.positions.len() as u32;
+                    mesh.positions.push(positions[i as usize]);
+                    mesh.normals.push(patch.normal(s, w));
+                    params.push(tri.params[i as usize]);
+                }
+                out[k] = *slot;
+            }
+            mesh.indices.push(out);
+        }
+        let boundary = tri
+            .boundary
+            .iter()
+            .map(|line| line.iter().map(|&i| positions[i as usize]).collect())
+            .collect();
+        let offset = self
+            .samples
+            .iter()
+            .flatten()
+            .map(|s| (s.position - s.point).length())
+            .fold(0.0, f64::max);
+        Ok(TrimmedFace {
+            mesh,
+            params,
+            boundary,
+            deviation: tri.deviation,
+            offset,
+        })
+    }
 }
 
 /// The points of a triangulation, each made once (by its exact bits).
@@ -249,84 +585,73 @@ impl Points {
     }
 }
 
-/// The triangles of the constrained Delaunay triangulation of `points` with the boundary
-/// polylines as constraints whose centres `region` keeps. A constraint that would cross an
-/// earlier one (loops that touch or cross themselves) is left out; the centre test still
-/// decides which triangles stay.
-fn constrained_delaunay(
-    points: &[DVec2],
-    boundary: &[Vec<u32>],
-    region: &TrimRegion,
-) -> Result<Vec<[u32; 3]>, TessellateError> {
-    let mut cdt = ConstrainedDelaunayTriangulation::<Point2<f64>>::new();
-    let mut handles = Vec::with_capacity(points.len());
-    for p in points {
-        handles.push(
-            cdt.insert(Point2::new(p.x, p.y))
-                .map_err(|e| TessellateError::Parameter(e.to_string()))?,
-        );
+type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
+
+/// Inserts a point; points are distinct, so spade's handles are the points' indices in
+/// insertion order.
+fn insert(cdt: &mut Cdt, p: DVec2) -> Result<(), TessellateError> {
+    cdt.insert(Point2::new(p.x, p.y))
+        .map(|_| ())
+        .map_err(|e| TessellateError::Parameter(e.to_string()))
+}
+
+fn vertex(i: u32) -> FixedVertexHandle {
+    FixedVertexHandle::from_index(i as usize)
+}
+
+/// Whether every piece's last sample is some piece's first (each loop's pieces follow one
+/// another end to start), so the constraint edges make closed polygons.
+fn loops_close(boundary: &[Vec<u32>]) -> bool {
+    let mut starts: Vec<u32> = boundary.iter().filter_map(|l| l.first().copied()).collect();
+    let mut ends: Vec<u32> = boundary.iter().filter_map(|l| l.last().copied()).collect();
+    starts.sort_unstable();
+    ends.sort_unstable();
+    starts == ends
+}
+
+/// The triangles inside the constraint polygons by the even–odd rule: parity flips across
+/// every constraint edge, starting outside at the hull (inverted when the domain's
+/// boundary is the outer loop).
+fn kept_by_parity(cdt: &Cdt, outer_is_domain: bool) -> Vec<[u32; 3]> {
+    let mut parity: Vec<Option<bool>> = vec![None; cdt.num_all_faces()];
+    let mut queue = VecDeque::new();
+    for face in cdt.inner_faces() {
+        if let Some(e) = face
+            .adjacent_edges()
+            .into_iter()
+            .find(|e| e.rev().face().is_outer())
+        {
+            parity[face.fix().index()] = Some(e.is_constraint_edge());
+            queue.push_back(face.fix());
+        }
     }
-    for polyline in boundary {
-        for w in polyline.windows(2) {
-            if w[0] != w[1] {
-                cdt.try_add_constraint(handles[w[0] as usize], handles[w[1] as usize]);
+    while let Some(f) = queue.pop_front() {
+        let inside = parity[f.index()].unwrap_or(false);
+        for e in cdt.face(f).adjacent_edges() {
+            if let Some(next) = e.rev().face().as_inner() {
+                let slot = &mut parity[next.fix().index()];
+                if slot.is_none() {
+                    *slot = Some(inside != e.is_constraint_edge());
+                    queue.push_back(next.fix());
+                }
             }
         }
     }
-    // Points are distinct, so spade's handles are the points' indices in insertion order.
-    Ok(cdt
-        .inner_faces()
+    cdt.inner_faces()
+        .filter(|f| parity[f.fix().index()].unwrap_or(false) != outer_is_domain)
+        .map(|f| f.vertices().map(|v| v.fix().index() as u32))
+        .collect()
+}
+
+/// The triangles whose centres `region` keeps.
+fn kept_by_centre(cdt: &Cdt, points: &[DVec2], region: &TrimRegion) -> Vec<[u32; 3]> {
+    cdt.inner_faces()
         .filter_map(|face| {
             let tri = face.vertices().map(|v| v.fix().index() as u32);
             let c = tri.iter().map(|&i| points[i as usize]).sum::<DVec2>() / 3.0;
             region.contains(c.x, c.y).then_some(tri)
         })
-        .collect())
-}
-
-/// The trimmed surface's mesh (vertices on the exact surface, exact normals) and its
-/// boundary in space.
-pub(super) fn tessellate_trimmed(
-    surface: &Surface,
-    region: &TrimRegion,
-    plan: Plan,
-) -> Result<TrimmedFace, TessellateError> {
-    let Some(patches) = Patches::of(surface, plan) else {
-        return Ok(TrimmedFace {
-            mesh: TriangleMesh::default(),
-            boundary: Vec::new(),
-        });
-    };
-    let tri = triangulate_patches(&patches, region, plan)?;
-    let mut mesh = TriangleMesh::default();
-    let mut index = vec![u32::MAX; tri.params.len()];
-    for t in &tri.triangles {
-        let mut out = [0u32; 3];
-        for (k, &i) in t.iter().enumerate() {
-            let slot = &mut index[i as usize];
-            if *slot == u32::MAX {
-                let (patch, s, w) = patches.at(tri.params[i as usize]);
-                *slot = u32::try_from(mesh.positions.len())
-                    .ok()
-                    .filter(|&n| n != u32::MAX)
-                    .ok_or(TessellateError::TooManyVertices)?;
-                mesh.positions.push(patch.eval(s, w) + DVec3::ZERO);
-                mesh.normals.push(patch.normal(s, w));
-            }
-            out[k] = *slot;
-        }
-        mesh.indices.push(out);
-    }
-    let boundary = tri
-        .boundary
-        .iter()
-        .map(|line| {
-            line.iter()
-                .map(|&i| patches.eval(tri.params[i as usize]))
-                .collect()
-        })
-        .collect();
-    Ok(TrimmedFace { mesh, boundary })
+        .collect()
 }
 
 #[cfg(test)]
@@ -400,7 +725,12 @@ mod tests {
     fn param_triangulation(surface: &Surface, mode: TessellationMode) -> ParamTriangulation {
         let plan = Plan::new(mode).unwrap();
         let region = surface.trim_region().unwrap().unwrap();
-        triangulate_patches(&Patches::of(surface, plan).unwrap(), &region, plan).unwrap()
+        let budget = Budget {
+            object: "",
+            triangles: MAX_TRIANGLES,
+        };
+        let face = Face::new(surface, region, plan).unwrap();
+        face.triangulate(plan, budget, 0).unwrap().0
     }
 
     #[test]

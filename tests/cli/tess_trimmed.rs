@@ -27,10 +27,7 @@ fn the_hammer_tessellates_with_its_trims_and_reports_the_gaps() {
     // A closed solid: nearly every boundary sample lies next to another face.
     assert!(shared > 1000 && free * 20 < shared, "{g}");
     let largest = g["largest"].as_f64().unwrap();
-    assert!(
-        largest > 0.0 && largest <= g["radius"].as_f64().unwrap(),
-        "{g}"
-    );
+    assert!(largest <= g["radius"].as_f64().unwrap(), "{g}");
     // The written mesh holds what the report counts.
     let text = std::fs::read_to_string(&out).unwrap();
     let faces = text.lines().filter(|l| l.starts_with("f ")).count() as u64;

@@ -41,6 +41,7 @@ mod step_part;
 mod step_sets;
 mod subdiv_surface;
 mod subdiv_tessellate;
+mod tess_closed_solids;
 mod tess_mesh;
 mod tess_watertight;
 mod toth_agreement;

@@ -96,6 +96,12 @@ impl TrimRegion {
         &self.map
     }
 
+    /// Whether every loop is a hole, so that the domain's boundary is the outer loop
+    /// (module docs).
+    pub fn outer_is_domain(&self) -> bool {
+        self.outer_is_domain
+    }
+
     /// Whether the surface exists at (u, v), in the surface's own parameters.
     pub fn contains(&self, u: f64, v: f64) -> bool {
         let p = DVec2::new(self.map[0].apply(u), self.map[1].apply(v));
