@@ -33,8 +33,8 @@ use super::scene::{SceneGeometry, SceneHit};
 use crate::geom::bbox::DAabb;
 use crate::geom::ulp::ulp_of;
 use crate::geom::{Aabb, Ray};
-use crate::kernel::Kernel;
 use crate::kernel::subdivision::{ScreenFootprint, Termination};
+use crate::kernel::{Kernel, SurfaceOrigin};
 
 /// How many times the world-space image of the re-entry rounding the leave box is grown
 /// by: the bound is reached only at once in every coordinate; twice leaves room for the
@@ -131,6 +131,12 @@ impl Placement {
                     cfg.termination =
                         Termination::Adaptive(footprint_in_object(fp, &self.to_world.matrix3));
                 }
+                cfg.surface_of_origin = cfg.surface_of_origin.and_then(|o| {
+                    Some(SurfaceOrigin {
+                        primitive: local(Some(o.primitive))?,
+                        ..o
+                    })
+                });
                 Kernel::F32(cfg)
             }
             Kernel::F64(cfg) => Kernel::F64(cfg),

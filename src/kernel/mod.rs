@@ -47,23 +47,37 @@ impl Kernel {
         }
     }
 
-    /// The path for secondary rays leaving a hit: [`Kernel::for_secondary_rays`], and
-    /// for the LG90 kernels with ISRT (LG90 §6, "improved treatment of secondary rays")
-    /// the surface of origin (its primitive number, `None` for a triangle), on which they
-    /// apply the triviality tests.
-    pub fn leaving(self, origin: Option<u32>) -> Kernel {
+    /// The path for secondary rays leaving a hit: [`Kernel::for_secondary_rays`] with the
+    /// surface of origin (`None` for a triangle), on which the kernels apply triviality
+    /// tests (LG90 §6, "improved treatment of secondary rays"): the `f32` subdivision
+    /// kernel its own ([`subdivision::trivial`]), the LG90 kernels theirs with ISRT. The
+    /// `f64` reference searches every surface in full.
+    pub fn leaving(self, origin: Option<SurfaceOrigin>) -> Kernel {
         match self.for_secondary_rays() {
-            Kernel::Toth(cfg) if cfg.isrt => Kernel::Toth(TothConfig {
+            Kernel::F32(cfg) => Kernel::F32(SubdivisionConfig {
                 surface_of_origin: origin,
                 ..cfg
             }),
+            Kernel::Toth(cfg) if cfg.isrt => Kernel::Toth(TothConfig {
+                surface_of_origin: origin.map(|o| o.primitive),
+                ..cfg
+            }),
             Kernel::Cached(mut cfg) if cfg.toth.isrt => {
-                cfg.toth.surface_of_origin = origin;
+                cfg.toth.surface_of_origin = origin.map(|o| o.primitive);
                 Kernel::Cached(cfg)
             }
             other => other,
         }
     }
+}
+
+/// Where a secondary ray leaves a patch: the patch's primitive number and the (u, v) of
+/// the hit on it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceOrigin {
+    pub primitive: u32,
+    pub u: f64,
+    pub v: f64,
 }
 
 /// A hit on one patch: `t` at the entry of the final box, (u, v) the centre of the final

@@ -11,7 +11,7 @@ use super::plan::{EffectPlan, MAX_TREE_RAYS};
 use super::stats::{RayKind, RayTally};
 use crate::accel::scene::{QueryStats, SceneGeometry, SceneHit};
 use crate::geom::Ray;
-use crate::kernel::Kernel;
+use crate::kernel::{Kernel, SurfaceOrigin};
 use crate::scene::{Light, Scene};
 
 /// Settings that apply to every ray of a render.
@@ -121,7 +121,14 @@ impl Integrator<'_> {
         let plan = &self.settings.plan;
         let ulps = self.settings.ulps;
         let opaque = 1.0 - m.transmit.min(1.0);
-        let leaving = self.settings.precision.leaving(hit.primitive);
+        let leaving = self
+            .settings
+            .precision
+            .leaving(hit.primitive.map(|primitive| SurfaceOrigin {
+                primitive,
+                u: hit.u,
+                v: hit.v,
+            }));
 
         let mut color = self.scene.ambient * m.diffuse * opaque;
         let above = hit.secondary_origin(n_out, true, ulps);

@@ -8,7 +8,7 @@ use super::{Kernel, SceneGeometry, SceneHit};
 use crate::geom::trim::PatchTrim;
 use crate::geom::{Aabb, Ray};
 use crate::kernel::cached::{self};
-use crate::kernel::subdivision::{self};
+use crate::kernel::subdivision::{self, SubdivisionConfig};
 use crate::kernel::toth::{self};
 use crate::kernel::triangle::{self, TriangleHit};
 use crate::kernel::{KernelStats, PatchHit};
@@ -40,7 +40,8 @@ impl SceneGeometry {
             }
             Kernel::F32(cfg) | Kernel::F64(cfg) => {
                 let prepared = self.patches.prepared(prim as usize);
-                subdivision::nearest(&prepared, trim, ray.kernel(cfg), tmax, cfg, kernel)
+                let leaving = leaving(cfg, prim);
+                subdivision::nearest(&prepared, trim, ray.kernel(cfg), tmax, cfg, leaving, kernel)
                     .map(|h| (h.t(), Candidate::Subdivision(prim, h)))
             }
         }
@@ -67,7 +68,8 @@ impl SceneGeometry {
             }
             Kernel::F32(cfg) | Kernel::F64(cfg) => {
                 let prepared = self.patches.prepared(prim as usize);
-                subdivision::blocks(&prepared, trim, ray.kernel(cfg), cfg, kernel)
+                let leaving = leaving(cfg, prim);
+                subdivision::blocks(&prepared, trim, ray.kernel(cfg), cfg, leaving, kernel)
             }
         }
     }
@@ -134,4 +136,11 @@ impl SceneGeometry {
             shading_normal,
         }
     }
+}
+
+/// The (u, v) of a secondary ray's origin on patch `prim` when the ray leaves that patch.
+fn leaving(cfg: &SubdivisionConfig, prim: u32) -> Option<(f64, f64)> {
+    cfg.surface_of_origin
+        .filter(|o| o.primitive == prim)
+        .map(|o| (o.u, o.v))
 }

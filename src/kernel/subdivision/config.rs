@@ -3,6 +3,8 @@
 //! Table 2.5, adaptive screen-space §2.5.3) and the mantissa distance that ends the
 //! subdivision of rational patches (§2.7.2).
 
+use crate::kernel::SurfaceOrigin;
+
 /// How the next split direction is chosen from the corner control points.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum SplitHeuristic {
@@ -125,6 +127,10 @@ pub struct SubdivisionConfig {
     /// extent of the surface; only its size grows. `None` (the `f64` reference) never
     /// coarsens.
     pub full_precision_splits: Option<u32>,
+    /// For a secondary ray, the surface it leaves and where: the search of that patch
+    /// skips the region around the origin that the ray provably does not cross
+    /// ([`super::trivial`]). Set by [`crate::kernel::Kernel::leaving`].
+    pub surface_of_origin: Option<SurfaceOrigin>,
 }
 
 impl Default for SubdivisionConfig {
@@ -136,6 +142,7 @@ impl Default for SubdivisionConfig {
             end_ulps: DEFAULT_END_ULPS,
             ray_space: true,
             full_precision_splits: Some(DEFAULT_FULL_PRECISION_SPLITS),
+            surface_of_origin: None,
         }
     }
 }

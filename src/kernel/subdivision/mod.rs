@@ -36,6 +36,7 @@ pub mod ray_space;
 pub mod reference;
 pub mod register;
 pub mod search;
+pub mod trivial;
 
 use std::cell::RefCell;
 
@@ -53,6 +54,7 @@ use bicubic::Net;
 use bilinear::BilinearNet;
 use float::{GBox, GRay};
 use general::{GeneralStack, Scratch};
+use param::ParamCell;
 use prepared::Prepared;
 use ray_space::{RayFrame, SpacedHit};
 use register::{Query, search_register};
@@ -162,19 +164,23 @@ pub fn intersect(
     stats: &mut KernelStats,
 ) -> Option<PatchHit> {
     let ray = KernelRay::new(ray, cfg);
-    nearest(patch, trim, &ray, ray.ray.tmax, cfg, stats).map(|h| ray.patch_hit(&h))
+    nearest(patch, trim, &ray, ray.ray.tmax, cfg, None, stats).map(|h| ray.patch_hit(&h))
 }
 
 /// [`intersect`] for a ray made once for every patch it meets, with `t` up to `tmax`.
+/// `leaving` is the (u, v) of the ray's origin when the ray leaves this patch (a
+/// secondary ray and its surface of origin): the search then skips the region around it
+/// that the ray provably does not cross ([`trivial`]).
 pub fn nearest(
     patch: &PreparedPatch,
     trim: Option<&PatchTrim>,
     ray: &KernelRay,
     tmax: f32,
     cfg: &SubdivisionConfig,
+    leaving: Option<(f64, f64)>,
     stats: &mut KernelStats,
 ) -> Option<KernelHit> {
-    run(patch, trim, ray, tmax, cfg, false, stats).map(KernelHit)
+    run(patch, trim, ray, tmax, cfg, false, leaving, stats).map(KernelHit)
 }
 
 /// `hit_box` grown on every side by [`NET_ROUNDING_ULPS`] ulps of the largest coordinate
@@ -194,20 +200,23 @@ pub fn occluded(
     cfg: &SubdivisionConfig,
     stats: &mut KernelStats,
 ) -> bool {
-    blocks(patch, trim, &KernelRay::new(ray, cfg), cfg, stats)
+    blocks(patch, trim, &KernelRay::new(ray, cfg), cfg, None, stats)
 }
 
-/// [`occluded`] for a ray made once for every patch it meets.
+/// [`occluded`] for a ray made once for every patch it meets; `leaving` as for
+/// [`nearest`].
 pub fn blocks(
     patch: &PreparedPatch,
     trim: Option<&PatchTrim>,
     ray: &KernelRay,
     cfg: &SubdivisionConfig,
+    leaving: Option<(f64, f64)>,
     stats: &mut KernelStats,
 ) -> bool {
-    run(patch, trim, ray, ray.ray.tmax, cfg, true, stats).is_some()
+    run(patch, trim, ray, ray.ray.tmax, cfg, true, leaving, stats).is_some()
 }
 
+#[allow(clippy::too_many_arguments)]
 fn run(
     patch: &PreparedPatch,
     trim: Option<&PatchTrim>,
@@ -215,9 +224,21 @@ fn run(
     tmax: f32,
     cfg: &SubdivisionConfig,
     any_hit: bool,
+    leaving: Option<(f64, f64)>,
     stats: &mut KernelStats,
 ) -> Option<SpacedHit> {
     let gray = GRay { tmax, ..ray.ray };
+    // On the AVX-512 path the descent around the origin is cheap (ray space, jumps): the
+    // triviality test saved about as much as it cost there (BENCHMARKS.md), so only the
+    // other paths take it.
+    #[cfg(target_arch = "x86_64")]
+    let leaving =
+        leaving.filter(|_| !(matches!(patch.data, Prepared::Bicubic(_)) && avx512::available()));
+    let trivial = leaving.and_then(|uv| trivial::trivial_cell(&patch.data, &gray, uv));
+    if trivial == Some(ParamCell::ROOT) {
+        stats.patch_tests += 1;
+        return None;
+    }
     let root = GBox::from_aabb(patch.bounds);
     let query = Query {
         root,
@@ -226,6 +247,7 @@ fn run(
         cfg,
         any_hit,
         trim,
+        trivial,
     };
     match &patch.data {
         #[cfg(target_arch = "x86_64")]
@@ -249,6 +271,7 @@ fn run(
                 cfg,
                 any_hit,
                 trim,
+                trivial,
                 stats,
             )
             .map(SpacedHit::world)

@@ -98,6 +98,18 @@ impl ParamCell {
         )
     }
 
+    /// Whether `other` lies inside this cell (a dyadic cell is inside another or disjoint
+    /// from it unless it contains it).
+    #[inline(always)]
+    pub fn contains(&self, other: &ParamCell) -> bool {
+        // Shifting by 63 clears a coordinate below 2^63: the root holds every cell.
+        let same = |a: u64, b: u64, level: u8| (a ^ b) >> (63 - level) == 0;
+        other.level_u >= self.level_u
+            && other.level_v >= self.level_v
+            && same(self.u0, other.u0, self.level_u)
+            && same(self.v0, other.v0, self.level_v)
+    }
+
     /// The centre of the cell, the (u, v) a hit reports (Dammertz code 2.3.8).
     pub fn centre(&self) -> (f64, f64) {
         let (u0, v0, wu, wv) = self.bounds();
@@ -130,6 +142,30 @@ mod tests {
                 (-f64::from(levels)).exp2(),
                 "{levels}"
             );
+        }
+    }
+
+    /// Against the cells' bounds as intervals.
+    #[test]
+    fn containment_is_interval_inclusion() {
+        let mut cells = vec![ParamCell::ROOT];
+        for _ in 0..3 {
+            let more: Vec<ParamCell> = cells
+                .iter()
+                .flat_map(|c| {
+                    let (a, b) = c.split(Split::U);
+                    let (d, e) = c.split(Split::V);
+                    [a, b, d, e]
+                })
+                .collect();
+            cells.extend(more);
+        }
+        for a in &cells {
+            for b in &cells {
+                let ((au, av, aw, ah), (bu, bv, bw, bh)) = (a.bounds(), b.bounds());
+                let inside = bu >= au && bu + bw <= au + aw && bv >= av && bv + bh <= av + ah;
+                assert_eq!(a.contains(b), inside, "{a:?} {b:?}");
+            }
         }
     }
 

@@ -62,6 +62,7 @@ pub fn intersect_f64(
         &cfg,
         false,
         trim,
+        None,
         &mut stats,
     )?;
     let (u, v) = h.cell.centre();

@@ -238,6 +238,8 @@ pub struct Query<'a> {
     pub any_hit: bool,
     /// The patch's trim loops, if it has any ([`super::search::search`]).
     pub trim: Option<&'a PatchTrim>,
+    /// A cell the ray provably does not cross ([`super::trivial`]).
+    pub trivial: Option<ParamCell>,
 }
 
 /// The reusable buffers of a register-net search: the pushed nets and the search nodes.
@@ -276,7 +278,7 @@ fn search_portable<N: RegisterNet>(
 ) -> Option<SearchHit<f32>> {
     let mut nets = RegisterStack::new(net, q.ray, slots);
     search(
-        &mut nets, nodes, q.root, q.ray, false, q.cfg, q.any_hit, q.trim, stats,
+        &mut nets, nodes, q.root, q.ray, false, q.cfg, q.any_hit, q.trim, q.trivial, stats,
     )
 }
 

@@ -109,7 +109,8 @@ pub struct SearchHit<T> {
 /// reused scratch (cleared here). With `any_hit` the first final box ends the search.
 /// With `trim`, a final box whose parameter cell's centre the patch's trim loops cut away
 /// is no hit and the search goes on behind it (Dammertz §2.6): the answer is the nearest
-/// surviving hit.
+/// surviving hit. Sub-patches whose cells lie inside `trivial` are dropped unsearched: the
+/// ray provably does not cross them ([`super::trivial`]).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub fn search<T: KernelFloat, S: NetStack<T>>(
@@ -121,6 +122,7 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
     cfg: &SubdivisionConfig,
     any_hit: bool,
     trim: Option<&PatchTrim>,
+    trivial: Option<ParamCell>,
     stats: &mut KernelStats,
 ) -> Option<SearchHit<T>> {
     stats.patch_tests += 1;
@@ -144,7 +146,9 @@ pub fn search<T: KernelFloat, S: NetStack<T>>(
     'search: loop {
         // A popped entry was tested against an older, longer ray; after a hit only boxes
         // entered more than the hit box's extent before it matter (`tmax` is that bound).
-        let live = cur.t_enter <= tmax && (best.is_none() || cur.t_enter < tmax);
+        let live = cur.t_enter <= tmax
+            && (best.is_none() || cur.t_enter < tmax)
+            && trivial.is_none_or(|q| !q.contains(&cur.cell));
         // A coarsened box is final only if the ray starts outside it (so a secondary ray
         // cannot take the coarse box around its own origin for a hit), until the last
         // doubling, after which every box is.

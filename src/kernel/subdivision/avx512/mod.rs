@@ -565,6 +565,7 @@ fn search_avx512(
         cfg,
         any_hit,
         trim,
+        trivial,
     }: Query,
     stats: &mut KernelStats,
 ) -> Option<SpacedHit> {
@@ -587,7 +588,7 @@ fn search_avx512(
             let floor = frame.world_length(end_game_diameter(&root, cfg.end_ulps));
             let mut nets = RegisterStack::with_registers(local, registers, floor, slots);
             let hit = search(
-                &mut nets, nodes, local_root, &axis, false, cfg, any_hit, trim, stats,
+                &mut nets, nodes, local_root, &axis, false, cfg, any_hit, trim, trivial, stats,
             )?;
             return Some(SpacedHit {
                 hit,
@@ -597,7 +598,7 @@ fn search_avx512(
     }
     let mut nets = RegisterStack::new(world, ray, slots);
     search(
-        &mut nets, nodes, root, ray, false, cfg, any_hit, trim, stats,
+        &mut nets, nodes, root, ray, false, cfg, any_hit, trim, trivial, stats,
     )
     .map(SpacedHit::world)
 }

@@ -64,6 +64,7 @@ fn world_space_search_is_bit_identical_to_the_sse_search() {
                 cfg: &cfg,
                 any_hit,
                 trim: None,
+                trivial: None,
             };
             let a = search_net16(&net, &mut scratch16, q, &mut s16);
             assert!(a.is_none_or(|h| h.ray_space_scale.is_none()));
@@ -98,6 +99,7 @@ fn ray_space_search_finds_the_world_space_hits() {
             cfg: &cfg,
             any_hit: false,
             trim: None,
+            trivial: None,
         };
         let h = search_net16(&net, &mut scratch, q, &mut stats)?;
         Some(match (h.ray_space_scale, frame) {
