@@ -85,3 +85,13 @@ def evidence(index, category, kind, ray, occ, occ_normal, pt, reference, edges):
         row += [""] * 7
     row += [g(math.dist(occ.point, pt.point)) if occ and pt else "", g(cos)]
     return row
+
+
+def cell(row, key):
+    """A table cell: blank for no value, floats to two decimals."""
+    value = row.get(key)
+    if value is None:
+        return ""
+    if isinstance(value, float):
+        return f"{value:.2f}"
+    return str(value)

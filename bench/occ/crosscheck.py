@@ -15,6 +15,7 @@ import time
 import traceback
 
 import check_file  # loads OpenCASCADE once, before any fork
+import compare
 import occ_model
 import roundtrip
 
@@ -172,17 +173,10 @@ def _child(send, check, path, folder, args):
     os._exit(0)
 
 
-def _cell(row, key):
-    value = row.get(key)
-    if value is None:
-        return ""
-    if isinstance(value, float):
-        return f"{value:.2f}"
-    return str(value)
 
 
 def one_line(row):
-    figures = " ".join(f"{k} {_cell(row, k)}" for k in row if k not in ("file", "written by", "note"))
+    figures = " ".join(f"{k} {compare.cell(row, k)}" for k in row if k not in ("file", "written by", "note"))
     writer = row.get("written by") or "(writer unknown)"
     return "  ".join(x for x in (row["file"], writer, figures, row.get("note", "")) if x)
 
@@ -196,7 +190,7 @@ def markdown(rows, seconds, args):
         "|" + "|".join("---" if c in ("file", "written by", "note") else "--:" for c in COLUMNS) + "|\n"
     )
     for row in rows:
-        cells = [f"`{row['file']}`"] + [_cell(row, c) for c in COLUMNS[1:]]
+        cells = [f"`{row['file']}`"] + [compare.cell(row, c) for c in COLUMNS[1:]]
         out.append("| " + " | ".join(c.replace("|", "/") for c in cells) + " |\n")
     measured = [r for r in rows if "wrong" in r]
     totals = {

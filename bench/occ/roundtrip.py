@@ -179,7 +179,7 @@ def markdown(rows, seconds, args):
     out.append("| " + " | ".join(COLUMNS) + " |\n")
     out.append("|" + "|".join("---" if c in ("file", "written by", "note") else "--:" for c in COLUMNS) + "|\n")
     for row in rows:
-        cells = [f"`{row['file']}`"] + [_cell(row, c) for c in COLUMNS[1:]]
+        cells = [f"`{row['file']}`"] + [compare.cell(row, c) for c in COLUMNS[1:]]
         out.append("| " + " | ".join(c.replace("|", "/") for c in cells) + " |\n")
     measured = [r for r in rows if "OCC wrong" in r]
     totals = {k: sum(r[k] for r in measured) for k in COUNTS}
@@ -195,12 +195,3 @@ def markdown(rows, seconds, args):
     )
     out.append(f"\nWhole run: {seconds:.0f} s.\n")
     return "".join(out)
-
-
-def _cell(row, key):
-    value = row.get(key)
-    if value is None:
-        return ""
-    if isinstance(value, float):
-        return f"{value:.2f}"
-    return str(value)

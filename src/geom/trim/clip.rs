@@ -17,7 +17,7 @@
 
 use glam::{DVec2, DVec3};
 
-use super::pieces::{Piece, loop_pieces, project};
+use super::pieces::{Piece, loop_pieces, point_at, project};
 use super::{ParamCurve, TrimError, TrimLoop, TrimSegment};
 use crate::geom::bezier::ParamRect;
 
@@ -211,13 +211,13 @@ fn cut(pieces: &[Piece], h: HalfPlane) -> Vec<Piece> {
 }
 
 fn midpoint(piece: &Piece) -> DVec2 {
-    project(de_casteljau(&piece.points, 0.5))
+    project(point_at(&piece.points, 0.5))
 }
 
 /// `piece` split where it crosses the line of `h`, in order; the split points get the
 /// line's coordinate exactly.
 fn split_at_line(piece: &Piece, h: HalfPlane) -> Vec<Piece> {
-    let f = |t: f64| h.signed(project(de_casteljau(&piece.points, t)));
+    let f = |t: f64| h.signed(project(point_at(&piece.points, t)));
     let mut ts: Vec<f64> = Vec::new();
     if piece.lo[h.axis] < h.at && piece.hi[h.axis] > h.at {
         let mut prev = (0.0, f(0.0));
@@ -287,17 +287,6 @@ fn bisect(f: &dyn Fn(f64) -> f64, mut a: (f64, f64), mut b: (f64, f64)) -> f64 {
         }
     }
     0.5 * (a.0 + b.0)
-}
-
-/// The homogeneous point at `t` (de Casteljau).
-fn de_casteljau(points: &[DVec3], t: f64) -> DVec3 {
-    let mut q = points.to_vec();
-    for level in 1..q.len() {
-        for i in 0..q.len() - level {
-            q[i] = q[i] * (1.0 - t) + q[i + 1] * t;
-        }
-    }
-    q[0]
 }
 
 /// The control points of the two parts of a Bézier curve at `t` (de Casteljau).

@@ -48,6 +48,17 @@ pub fn hull(points: &[DVec3]) -> (DVec2, DVec2) {
     )
 }
 
+/// The homogeneous point of a rational Bézier curve at `t` (de Casteljau).
+pub fn point_at(points: &[DVec3], t: f64) -> DVec3 {
+    let mut q = points.to_vec();
+    for level in 1..q.len() {
+        for i in 0..q.len() - level {
+            q[i] = q[i] * (1.0 - t) + q[i + 1] * t;
+        }
+    }
+    q[0]
+}
+
 /// de Casteljau at 1/2 on homogeneous points: `points` becomes the lower half, `upper`
 /// receives the upper half (both of `points.len()` points).
 pub fn halve(points: &mut [DVec3], upper: &mut [DVec3]) {

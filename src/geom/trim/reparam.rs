@@ -15,7 +15,7 @@
 
 use glam::{DVec2, DVec3};
 
-use super::pieces::{Piece, loop_pieces, project};
+use super::pieces::{Piece, loop_pieces, point_at, project};
 use super::{AxisMap, ParamCurve, TrimError, TrimLoop, TrimSegment};
 use crate::geom::bezier::ParamRect;
 
@@ -74,21 +74,10 @@ fn mapped_piece(
     if straight && (0..2).all(|k| !varies(k) || other_constant(k)) {
         return line_segment(map(a), map(b));
     }
-    let f = |s: f64| map(project(de_casteljau(&piece.points, s)));
+    let f = |s: f64| map(project(point_at(&piece.points, s)));
     let mut cubics: Vec<[DVec2; 4]> = Vec::new();
     approximate(&f, 0.0, 1.0, tolerance, MAX_DEPTH, &mut cubics);
     piecewise_cubic(&cubics)
-}
-
-/// The homogeneous point of a rational Bézier curve at `s`.
-fn de_casteljau(points: &[DVec3], s: f64) -> DVec3 {
-    let mut q = points.to_vec();
-    for level in 1..q.len() {
-        for i in 0..q.len() - level {
-            q[i] = q[i] * (1.0 - s) + q[i + 1] * s;
-        }
-    }
-    q[0]
 }
 
 /// Appends to `out`, in order, cubics that interpolate `f` on `[s0, s1]` at its ends and
@@ -242,7 +231,7 @@ mod tests {
         let mut worst: f64 = 0.0;
         for p in &pieces {
             for k in 0..=16 {
-                let q = project(de_casteljau(&p.points, k as f64 / 16.0));
+                let q = project(point_at(&p.points, k as f64 / 16.0));
                 // Back to angles exactly, then the distance from the circle there.
                 let a = DVec2::new(map[0].apply(q.x), q.y);
                 worst = worst.max(((a - c).length() - r).abs());
