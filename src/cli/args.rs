@@ -37,6 +37,14 @@ pub enum Command {
     Diff(DiffArgs),
     /// Render the exact surfaces and triangle tessellations of a scene, diff them, and
     /// tabulate accuracy against cost.
+    ///
+    /// Besides the image metrics, each row gives the surface error: the distance along
+    /// each pixel's centre ray between the exact surface's nearest hit and the mesh's,
+    /// over the pixels both hit (max, 99th percentile and mean, in model units), drawn as
+    /// `<image>-distance.png` scaled to the row's largest. Where a mesh edge covers a pixel
+    /// the exact surface leaves to a farther face (an occluding contour, a crack), the
+    /// whole depth step counts: the max then measures that step, the mean and percentile
+    /// the surface.
     Compare(CompareArgs),
     /// Generate test scenes.
     #[command(subcommand)]
@@ -601,7 +609,8 @@ pub struct CompareArgs {
     /// render with that same material.
     #[arg(long, value_delimiter = ',', value_name = "MESH")]
     pub against: Vec<PathBuf>,
-    /// Directory for the images, heat maps and the table (created if missing).
+    /// Directory for the images, FLIP and surface-error heat maps and the table (created
+    /// if missing).
     #[arg(long, default_value = "compare-out")]
     pub out_dir: PathBuf,
     #[command(flatten)]

@@ -25,8 +25,9 @@ use crate::kernel::subdivision::SubdivisionConfig;
 use crate::render::film::Film;
 use crate::render::heatmap::heat_map;
 use crate::render::integrator::{Integrator, TraceSettings};
+use crate::render::order::SampleOrder;
 use crate::render::plan::EffectPlan;
-use crate::render::renderer::render_image;
+use crate::render::renderer::{RenderJob, render as render_job};
 use crate::scene::{Geometry, Object, Scene, TriangleMesh};
 use crate::tessellate::{TessellationMode, TessellationReport};
 
@@ -43,10 +44,55 @@ struct Row {
     silhouette_pixels: u64,
     /// The largest gap between trimmed faces (tessellations only).
     trim_gap: Option<f64>,
+    /// How far the mesh lies from the exact surface along the pixels' centre rays.
+    surface_error: SurfaceError,
+}
+
+/// Distances along each pixel's centre ray between the exact surface's nearest hit and the
+/// mesh's, over the pixels where both hit (pixels where only one does are the silhouette
+/// count): the geometric error a viewer of the image sees, in model units.
+#[derive(Clone, Copy, Default)]
+struct SurfaceError {
+    max: f64,
+    p99: f64,
+    mean: f64,
+}
+
+impl SurfaceError {
+    /// The distances per pixel (`None` where either misses) and their summary.
+    fn between(exact: &[Option<f64>], mesh: &[Option<f64>]) -> (Vec<Option<f64>>, SurfaceError) {
+        let per_pixel: Vec<Option<f64>> = exact
+            .iter()
+            .zip(mesh)
+            .map(|(a, b)| Some((a.as_ref()? - b.as_ref()?).abs()))
+            .collect();
+        let mut d: Vec<f64> = per_pixel.iter().flatten().copied().collect();
+        if d.is_empty() {
+            return (per_pixel, SurfaceError::default());
+        }
+        d.sort_by(f64::total_cmp);
+        let p99 = d[((d.len() - 1) as f64 * 0.99).round() as usize];
+        let mean = d.iter().sum::<f64>() / d.len() as f64;
+        let summary = SurfaceError {
+            max: d[d.len() - 1],
+            p99,
+            mean,
+        };
+        (per_pixel, summary)
+    }
+}
+
+/// A render, its centre rays' hit distances (`None` for a miss), and the seconds spent
+/// building the accelerator and rendering.
+struct Rendering {
+    film: Film,
+    depth: Vec<Option<f64>>,
+    build: f64,
+    seconds: f64,
 }
 
 /// Builds the accelerator and renders, timing both.
-fn render(scene: &Scene, quiet: bool, label: &str, pool: &rayon::ThreadPool) -> (Film, f64, f64) {
+fn render(scene: &Scene, quiet: bool, label: &str, pool: &rayon::ThreadPool) -> Rendering {
     let start = Instant::now();
     let geometry = build_bvh(scene, quiet);
     let build = start.elapsed().as_secs_f64();
@@ -61,8 +107,17 @@ fn render(scene: &Scene, quiet: bool, label: &str, pool: &rayon::ThreadPool) -> 
     };
     let bar = crate::progress::bar(quiet, label);
     let start = Instant::now();
-    let film = pool.install(|| render_image(&integrator, &bar)).film;
-    (film, build, start.elapsed().as_secs_f64())
+    let job = RenderJob {
+        hits: true,
+        ..RenderJob::whole(&scene.camera, SampleOrder::default())
+    };
+    let rendered = pool.install(|| render_job(&integrator, &job, &bar));
+    Rendering {
+        film: rendered.film,
+        depth: rendered.hits.iter().map(|h| h.map(|h| h.hit.t)).collect(),
+        build,
+        seconds: start.elapsed().as_secs_f64(),
+    }
 }
 
 pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
@@ -81,20 +136,21 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
         eprintln!("{}", EffectPlan::for_scene(&scene));
     }
 
-    let (direct, build, render_seconds) = render(&scene, args.quiet, "direct", &pool);
-    direct.write(&args.out_dir.join("direct.png"))?;
-    let reference = Image::from_film(&direct);
+    let direct = render(&scene, args.quiet, "direct", &pool);
+    direct.film.write(&args.out_dir.join("direct.png"))?;
+    let reference = Image::from_film(&direct.film);
     let mut rows = vec![Row {
         method: "direct (f32 subdivision)".into(),
         triangles: 0,
         memory_bytes: patch_memory(&scene),
-        build_seconds: build,
-        render_seconds,
+        build_seconds: direct.build,
+        render_seconds: direct.seconds,
         rmse: 0.0,
         psnr: f64::INFINITY,
         flip_mean: 0.0,
         silhouette_pixels: 0,
         trim_gap: None,
+        surface_error: SurfaceError::default(),
     }];
 
     let triangles =
@@ -129,6 +185,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
         let tessellate_seconds = start.elapsed().as_secs_f64();
         let against = Against {
             reference: &reference,
+            depth: &direct.depth,
             out_dir: &args.out_dir,
             quiet: args.quiet,
             pool: &pool,
@@ -144,11 +201,12 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
     if !args.against.is_empty() {
         // External meshes carry no materials: both sides are rendered with one.
         let plain = one_material(&scene);
-        let (direct, _, _) = render(&plain, args.quiet, "direct, one material", &pool);
-        direct.write(&args.out_dir.join("direct-plain.png"))?;
-        let reference = Image::from_film(&direct);
+        let direct = render(&plain, args.quiet, "direct, one material", &pool);
+        direct.film.write(&args.out_dir.join("direct-plain.png"))?;
+        let reference = Image::from_film(&direct.film);
         let against = Against {
             reference: &reference,
+            depth: &direct.depth,
             out_dir: &args.out_dir,
             quiet: args.quiet,
             pool: &pool,
@@ -196,41 +254,58 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
 /// What every compared render is measured against, and where its files go.
 struct Against<'a> {
     reference: &'a Image,
+    /// The direct render's centre-ray hit distances.
+    depth: &'a [Option<f64>],
     out_dir: &'a Path,
     quiet: bool,
     pool: &'a rayon::ThreadPool,
 }
 
 impl Against<'_> {
-    /// Renders `meshes`, writes the image and its FLIP heat map as `<image>.png` and
-    /// `<heat>.png`, and returns its row (triangle counts and memory for the caller to
-    /// fill in).
+    /// Renders `meshes`, writes the image, its FLIP heat map and the heat map of its
+    /// surface error (scaled to the row's largest) as `<image>.png`, `<heat>.png` and
+    /// `<image>-distance.png`, and returns its row (triangle counts and memory for the
+    /// caller to fill in).
     fn row(
         &self,
         meshes: &Scene,
         label: &str,
         (image, heat): &(String, String),
     ) -> anyhow::Result<Row> {
-        let (film, build, render_seconds) = render(meshes, self.quiet, label, self.pool);
-        film.write(&self.out_dir.join(format!("{image}.png")))?;
+        let mesh = render(meshes, self.quiet, label, self.pool);
+        mesh.film
+            .write(&self.out_dir.join(format!("{image}.png")))?;
         let d = diff_images(
             self.reference,
-            &Image::from_film(&film),
+            &Image::from_film(&mesh.film),
             DiffOptions::default(),
         )?;
         heat_map(&d.maps.flip, d.width, d.height)
             .write_png(&self.out_dir.join(format!("{heat}.png")))?;
+        let (per_pixel, surface_error) = SurfaceError::between(self.depth, &mesh.depth);
+        let scale = if surface_error.max > 0.0 {
+            surface_error.max
+        } else {
+            1.0
+        };
+        let shades: Vec<f32> = per_pixel
+            .iter()
+            .map(|e| e.map_or(0.0, |e| (e / scale) as f32))
+            .collect();
+        heat_map(&shades, d.width, d.height)
+            .write_png(&self.out_dir.join(format!("{image}-distance.png")))?;
         Ok(Row {
             method: label.to_string(),
             triangles: 0,
             memory_bytes: 0,
-            build_seconds: build,
-            render_seconds,
+            build_seconds: mesh.build,
+            render_seconds: mesh.seconds,
             rmse: d.rmse,
             psnr: d.psnr,
             flip_mean: d.flip.mean,
             silhouette_pixels: d.coverage_mismatch.unwrap_or(0),
             trim_gap: None,
+            surface_error,
         })
     }
 }
@@ -268,7 +343,7 @@ fn write_text(path: &Path, text: &str) -> anyhow::Result<()> {
     Ok(())
 }
 
-const COLUMNS: [&str; 10] = [
+const COLUMNS: [&str; 13] = [
     "method",
     "triangles",
     "memory (bytes)",
@@ -279,9 +354,12 @@ const COLUMNS: [&str; 10] = [
     "FLIP mean",
     "silhouette pixels",
     "trim gap",
+    "surface error max",
+    "surface error p99",
+    "surface error mean",
 ];
 
-fn cells(r: &Row) -> [String; 10] {
+fn cells(r: &Row) -> [String; 13] {
     [
         r.method.clone(),
         r.triangles.to_string(),
@@ -297,6 +375,9 @@ fn cells(r: &Row) -> [String; 10] {
         format!("{:.5}", r.flip_mean),
         r.silhouette_pixels.to_string(),
         r.trim_gap.map_or("-".into(), |g| format!("{g:.3e}")),
+        format!("{:.3e}", r.surface_error.max),
+        format!("{:.3e}", r.surface_error.p99),
+        format!("{:.3e}", r.surface_error.mean),
     ]
 }
 

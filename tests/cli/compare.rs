@@ -206,3 +206,63 @@ fn chord_tolerances_and_a_mesh_from_elsewhere_take_their_rows() {
         );
     }
 }
+
+/// The surface-error columns (max, p99, mean) of `compare`'s CSV, per row.
+fn surface_errors(csv: &str) -> Vec<[f64; 3]> {
+    csv.lines()
+        .skip(1)
+        .map(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            [10, 11, 12].map(|k| cells[k].parse::<f64>().unwrap())
+        })
+        .collect()
+}
+
+#[test]
+fn surface_error_is_rounding_on_a_plane_and_not_on_a_coarse_teapot() {
+    // A mesh of a plane lies in the plane: along every ray that hits both, the two hits
+    // are one point up to f32 rounding. Eight triangles per patch of the teapot cut
+    // through its curvature: the mesh lies visibly off the surface.
+    let dir = tempfile::tempdir().unwrap();
+    let plane = dir.path().join("plane.obj");
+    std::fs::write(
+        &plane,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\ncstype bezier\ndeg 1 1\nsurf 0 1 0 1 1 2 3 4\nparm u 0 1\nparm v 0 1\nend\n",
+    )
+    .unwrap();
+    let mut errors = Vec::new();
+    // Heat maps are named after the mesh's image: chord height 0.01 of the plane's
+    // diagonal, √2, and 8 triangles per patch.
+    for (scene, mode, heat) in [
+        (plane.clone(), ["--tolerance", "0.01"], "chord1.414e-2"),
+        (testdata("teapot.ron"), ["--triangles", "8"], "tess8"),
+    ] {
+        let out = dir.path().join(scene.file_stem().unwrap());
+        let o = run(&[
+            "compare",
+            scene.to_str().unwrap(),
+            mode[0],
+            mode[1],
+            "--out-dir",
+            out.to_str().unwrap(),
+            "--width",
+            "64",
+            "--height",
+            "64",
+            "-q",
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let csv = std::fs::read_to_string(out.join("compare.csv")).unwrap();
+        let rows = surface_errors(&csv);
+        assert_eq!(
+            rows[0],
+            [0.0, 0.0, 0.0],
+            "the direct render against itself: {csv}"
+        );
+        assert!(out.join(format!("{heat}-distance.png")).exists());
+        errors.push(rows[1]);
+    }
+    // The plane is 1.41 across, the teapot about 7.
+    assert!(errors[0][0] < 1e-5, "plane: {:?}", errors[0]);
+    assert!(errors[1][2] > 1e-3 * 7.0, "teapot: {:?}", errors[1]);
+}

@@ -13,7 +13,7 @@
 //! at four points each, halved until the mapped curve and the cubic agree to within
 //! [`RELATIVE_TOLERANCE`] of the domain's extent at the check points.
 
-use glam::{DVec2, DVec3};
+use glam::DVec2;
 
 use super::pieces::{Piece, loop_pieces, point_at, project};
 use super::{AxisMap, ParamCurve, TrimError, TrimLoop, TrimSegment};
