@@ -17,6 +17,7 @@ pub mod curves;
 pub mod directory;
 pub mod elementary;
 pub mod entities;
+mod projection;
 pub mod records;
 pub mod surfaces;
 pub mod trimmed;

@@ -22,6 +22,7 @@ pub mod entities;
 pub mod geometry;
 pub mod items;
 pub mod lexer;
+mod loop_piece;
 pub mod records;
 pub mod style;
 pub mod surfaces;
