@@ -7,11 +7,10 @@
 //! no other face within [`NEIGHBOUR_FRACTION`] of the model's size lie on a free edge (or
 //! next to an untrimmed surface) and are counted apart, not mixed into the gap.
 
-use std::collections::HashMap;
-
 use glam::DVec3;
 use serde::Serialize;
 
+use super::cubes::Cubes;
 use crate::geom::segment::distance_to_segment;
 
 /// How near (as a fraction of the diagonal of all trimmed boundaries' box) another face's
@@ -80,72 +79,42 @@ pub fn measure(faces: &[Vec<Vec<DVec3>>]) -> TrimGaps {
 /// neighbouring one.
 struct SegmentGrid<'a> {
     faces: &'a [Vec<Vec<DVec3>>],
-    cube: f64,
-    origin: DVec3,
-    cells: HashMap<[i64; 3], Vec<(u32, u32, u32)>>,
+    cubes: Cubes<(u32, u32, u32)>,
 }
 
 impl<'a> SegmentGrid<'a> {
     fn new(faces: &'a [Vec<Vec<DVec3>>], radius: f64, origin: DVec3) -> Self {
-        let mut grid = SegmentGrid {
-            faces,
-            cube: 2.0 * radius,
-            origin,
-            cells: HashMap::new(),
-        };
+        let mut cubes = Cubes::new(2.0 * radius, origin);
         for (f, lines) in faces.iter().enumerate() {
             for (l, line) in lines.iter().enumerate() {
                 for (s, w) in line.windows(2).enumerate() {
-                    if !(w[0].is_finite() && w[1].is_finite()) {
-                        continue;
-                    }
-                    let steps = ((w[1] - w[0]).length() / (0.5 * radius)).ceil().max(1.0) as usize;
-                    let mut last = None;
-                    for k in 0..=steps {
-                        let key = grid.key(w[0].lerp(w[1], k as f64 / steps as f64));
-                        if last != Some(key) {
-                            grid.cells
-                                .entry(key)
-                                .or_default()
-                                .push((f as u32, l as u32, s as u32));
-                            last = Some(key);
-                        }
+                    if w[0].is_finite() && w[1].is_finite() {
+                        cubes.insert_segment(
+                            w[0],
+                            w[1],
+                            0.5 * radius,
+                            (f as u32, l as u32, s as u32),
+                        );
                     }
                 }
             }
         }
-        for list in grid.cells.values_mut() {
-            list.sort_unstable();
-            list.dedup();
-        }
-        grid
-    }
-
-    fn key(&self, p: DVec3) -> [i64; 3] {
-        ((p - self.origin) / self.cube)
-            .floor()
-            .to_array()
-            .map(|x| x as i64)
+        SegmentGrid { faces, cubes }
     }
 
     /// The distance from `p` to the nearest segment of a face other than `face` in `p`'s
     /// cube and its neighbours.
     fn nearest_other(&self, p: DVec3, face: usize) -> Option<f64> {
-        let c = self.key(p);
         let mut best: Option<f64> = None;
-        for dz in -1..=1 {
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    let Some(list) = self.cells.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) else {
-                        continue;
-                    };
-                    for &(f, l, s) in list.iter().filter(|e| e.0 as usize != face) {
-                        let line = &self.faces[f as usize][l as usize];
-                        let d = distance_to_segment(p, line[s as usize], line[s as usize + 1]);
-                        best = Some(best.map_or(d, |b| b.min(d)));
-                    }
-                }
-            }
+        for (f, l, s) in self
+            .cubes
+            .near(p)
+            .into_iter()
+            .filter(|e| e.0 as usize != face)
+        {
+            let line = &self.faces[f as usize][l as usize];
+            let d = distance_to_segment(p, line[s as usize], line[s as usize + 1]);
+            best = Some(best.map_or(d, |b| b.min(d)));
         }
         best
     }

@@ -17,6 +17,7 @@
 //! gaps remain (free edges, edges farther apart than the file's tolerance) are measured
 //! and reported ([`gaps`]), and so is the largest distance of the surface from the mesh.
 
+mod cubes;
 mod edge;
 pub mod gaps;
 mod shared;

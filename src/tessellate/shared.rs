@@ -24,6 +24,7 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 
+use super::cubes::Cubes;
 use super::trimmed::{Face, Sample};
 use crate::geom::segment::distance_to_segment;
 
@@ -171,7 +172,6 @@ impl UnionFind {
 }
 
 /// A segment in a cube: face, piece, segment (from sample `s` to `s + 1`), reach.
-type Entry = (u32, u32, u32, f64);
 
 /// The segments between consecutive samples of every piece, hashed into cubes: each
 /// segment into the cubes of points along it at most half a cube apart, so that a point
@@ -179,9 +179,20 @@ type Entry = (u32, u32, u32, f64);
 /// `reach` is how far a point of its exact curve may lie from it: the join distance plus
 /// twice the largest distance of the curve from the chord at the chord probes.
 struct SegmentGrid {
-    cube: f64,
-    origin: DVec3,
-    cells: HashMap<[i64; 3], Vec<Entry>>,
+    cubes: Cubes<(u32, u32, u32, Reach)>,
+}
+
+/// A segment's reach, ordered by value so that entries sort (the grid files each segment
+/// once per cube; ties between equal segments never arise).
+#[derive(Clone, Copy, PartialEq, PartialOrd)]
+struct Reach(f64);
+
+impl Eq for Reach {}
+
+impl Ord for Reach {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
 }
 
 impl SegmentGrid {
@@ -213,30 +224,11 @@ impl SegmentGrid {
         // Cubes no smaller than 1/256 of the model, so that long segments are walked in a
         // bounded number of steps.
         let cube = (2.0 * widest).max(size / 256.0);
-        let mut grid = SegmentGrid {
-            cube,
-            origin,
-            cells: HashMap::new(),
-        };
+        let mut cubes = Cubes::new(cube, origin);
         for (f, k, s, reach, a, b) in segments {
-            let steps = ((b - a).length() / (0.5 * cube)).ceil().max(1.0) as usize;
-            let mut last = None;
-            for i in 0..=steps {
-                let key = grid.key(a.lerp(b, i as f64 / steps as f64));
-                if last != Some(key) {
-                    grid.cells.entry(key).or_default().push((f, k, s, reach));
-                    last = Some(key);
-                }
-            }
+            cubes.insert_segment(a, b, 0.5 * cube, (f, k, s, Reach(reach)));
         }
-        grid
-    }
-
-    fn key(&self, p: DVec3) -> [i64; 3] {
-        ((p - self.origin) / self.cube)
-            .floor()
-            .to_array()
-            .map(|x| x as i64)
+        SegmentGrid { cubes }
     }
 
     /// For every piece other than `own` whose exact curve comes within `eps` of `p`, the
@@ -248,21 +240,9 @@ impl SegmentGrid {
         own: (usize, usize),
         eps: f64,
     ) -> Vec<((usize, usize), f64)> {
-        let c = self.key(p);
-        let mut candidates = Vec::new();
-        for dz in -1..=1 {
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    if let Some(list) = self.cells.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
-                        candidates.extend(list.iter().copied());
-                    }
-                }
-            }
-        }
-        candidates.sort_unstable_by_key(|&(f, k, s, _)| (f, k, s));
-        candidates.dedup_by_key(|&mut (f, k, s, _)| (f, k, s));
+        let candidates = self.cubes.near(p);
         let mut best: Vec<((usize, usize), f64, f64)> = Vec::new();
-        for (f, k, s, reach) in candidates {
+        for (f, k, s, Reach(reach)) in candidates {
             let piece = (f as usize, k as usize);
             if piece == own {
                 continue;
