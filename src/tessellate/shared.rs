@@ -171,23 +171,34 @@ impl UnionFind {
     }
 }
 
-/// A segment in a cube: face, piece, segment (from sample `s` to `s + 1`), reach.
-
 /// The segments between consecutive samples of every piece, hashed into cubes: each
 /// segment into the cubes of points along it at most half a cube apart, so that a point
 /// within half a cube of the segment lies in a cube next to one of them. A segment's
 /// `reach` is how far a point of its exact curve may lie from it: the join distance plus
 /// twice the largest distance of the curve from the chord at the chord probes.
 struct SegmentGrid {
+    /// Per cube: face, piece, segment (from sample `s` to `s + 1`), reach.
     cubes: Cubes<(u32, u32, u32, Reach)>,
 }
 
-/// A segment's reach, ordered by value so that entries sort (the grid files each segment
-/// once per cube; ties between equal segments never arise).
-#[derive(Clone, Copy, PartialEq, PartialOrd)]
+/// A segment's reach, ordered by value (`f64::total_cmp`) so that entries sort and
+/// deduplicate in the cubes.
+#[derive(Clone, Copy)]
 struct Reach(f64);
 
+impl PartialEq for Reach {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other).is_eq()
+    }
+}
+
 impl Eq for Reach {}
+
+impl PartialOrd for Reach {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
 
 impl Ord for Reach {
     fn cmp(&self, other: &Self) -> std::cmp::Ordering {
