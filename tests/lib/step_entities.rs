@@ -390,9 +390,9 @@ fn cone_sphere_and_torus_faces_match_their_definitions() {
             m.report.failed_faces
         );
         assert!(
-            m.report.max_projection_error < 1e-12 * scale,
+            m.report.max_trim_error < 1e-12 * scale,
             "{name}: {}",
-            m.report.max_projection_error
+            m.report.max_trim_error
         );
         let s = surfaces(&m).remove(0);
         let err = worst_error(&s, def, scale);

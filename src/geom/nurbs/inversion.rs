@@ -37,6 +37,10 @@ const STARTS: usize = 4;
 const MAX_STEPS: usize = 40;
 /// Step halvings before a descent gives up on a direction.
 const MAX_HALVINGS: usize = 30;
+/// The normal equations count as singular when det(JᵀJ) is below this fraction of the
+/// product of its diagonal: S_u and S_v within about 1e-6 rad of parallel, or one of them
+/// vanishing, where the 2 × 2 solve would only amplify rounding.
+const DEGENERATE: f64 = 1e-12;
 /// Near the minimum the distance is flat (it changes with the square of the parameter
 /// error), so a step that leaves it the same up to a few ulps of the coordinates is still
 /// progress: the step comes from the gradient, which keeps resolving the foot point.
@@ -179,10 +183,19 @@ impl Inverter {
             let (a, b, c) = (su.dot(su), su.dot(sv), sv.dot(sv));
             let (g0, g1) = (su.dot(r), sv.dot(r));
             let det = a * c - b * b;
-            if !(det > 0.0 && det.is_finite()) {
+            let (mut du, mut dv) = if det > DEGENERATE * a * c && det.is_finite() {
+                (-(c * g0 - b * g1) / det, -(a * g1 - b * g0) / det)
+            } else if a >= c && a > 0.0 {
+                // A degenerate Jacobian: S_v vanishes (a collapsed boundary, a pole, where
+                // every v is one point) or S_u ∥ S_v. Newton along the direction that
+                // still moves the point leaves the degenerate point; the full step
+                // follows from there.
+                (-g0 / a, 0.0)
+            } else if c > 0.0 {
+                (0.0, -g1 / c)
+            } else {
                 break;
-            }
-            let (mut du, mut dv) = (-(c * g0 - b * g1) / det, -(a * g1 - b * g0) / det);
+            };
             let mut improved = false;
             for _ in 0..MAX_HALVINGS {
                 let (nu, nv) = ((u + du).clamp(u_lo, u_hi), (v + dv).clamp(v_lo, v_hi));
@@ -265,6 +278,25 @@ mod tests {
                 assert!((hit.distance - offset.abs()).abs() < 1e-12, "{k}, {offset}");
                 let foot = s.eval(hit.u, hit.v);
                 assert!((foot - n * r).length() < 1e-10 * r, "{k}, {offset}: {foot}");
+            }
+        }
+    }
+
+    #[test]
+    fn points_beside_a_pole_leave_it() {
+        // At the NURBS sphere's poles one parameter moves nothing (its Jacobian is
+        // singular), and every start sample of the pole row is the pole itself: the
+        // nearest point of a point beside the pole is still radial (closed form).
+        let r = 2.0;
+        let s = shapes::sphere(r).unwrap();
+        let inv = Inverter::new(&s);
+        for pole in [DVec3::Z, -DVec3::Z] {
+            for (angle, around) in [(1e-3, 0.3), (2e-2, 2.0), (0.1, -1.0)] {
+                let side = DVec3::new(f64::cos(around), f64::sin(around), 0.0);
+                let n = (pole * f64::cos(angle) + side * f64::sin(angle)).normalize();
+                let q = n * (r + 0.01);
+                let hit = inv.project(q).unwrap();
+                assert!((hit.distance - 0.01).abs() < 1e-12, "{n}: {}", hit.distance);
             }
         }
     }

@@ -62,25 +62,39 @@ pub fn collapsed(s: &impl ParamSurface, uv: DVec2, axis: usize, tol: f64) -> boo
     })
 }
 
+/// How closely a projection follows its curve, in model units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tolerance {
+    /// Largest distance between a chord's image on the surface and the projected curve.
+    pub chord: f64,
+    /// Two surface points this close are one point: a periodic parameter that moves the
+    /// point less than this over a quarter period has collapsed (a pole, an apex).
+    pub point: f64,
+}
+
 /// A curve projected into a surface's parameters.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Projected {
     /// The polyline in parameter space, from the curve's start to its end.
     pub points: Vec<DVec2>,
-    /// The largest distance met between a curve sample and its image on the surface, or
-    /// between a chord's image and the projected curve.
-    pub error: f64,
+    /// The largest distance met between a curve sample and its image on the surface: how
+    /// far the curve itself lies from the surface (the file's own gap, where the curve is
+    /// an edge of a face on it).
+    pub gap: f64,
+    /// The largest distance between a chord's image on the surface and the projected
+    /// curve: how far the polyline strays from the projection (this reader's own error).
+    pub chord: f64,
 }
 
 /// The projection of `curve` over `[ta, tb]` onto `s` as a polyline refined until every
-/// chord's midpoint maps within `tol` of the projected curve (at most 4096 pieces);
+/// chord's midpoint maps within `tol.chord` of the projected curve (at most 4096 pieces);
 /// `Err(p)` names a curve point that could not be inverted.
 pub fn project(
     s: &impl ParamSurface,
     curve: impl Fn(f64) -> DVec3,
     ta: f64,
     tb: f64,
-    tol: f64,
+    tol: Tolerance,
 ) -> Result<Projected, DVec3> {
     let mut worst: f64 = 0.0;
     let mut measure = |t: f64, near: Option<DVec2>| -> Result<DVec2, DVec3> {
@@ -119,9 +133,11 @@ pub fn project(
     // (any value is the same point there; the neighbour's keeps the chords on the curve).
     for axis in 0..2 {
         for k in 0..uvs.len() {
-            if collapsed(s, uvs[k], axis, tol) {
-                let next = (k + 1..uvs.len()).find(|&j| !collapsed(s, uvs[j], axis, tol));
-                let prev = (0..k).rev().find(|&j| !collapsed(s, uvs[j], axis, tol));
+            if collapsed(s, uvs[k], axis, tol.point) {
+                let next = (k + 1..uvs.len()).find(|&j| !collapsed(s, uvs[j], axis, tol.point));
+                let prev = (0..k)
+                    .rev()
+                    .find(|&j| !collapsed(s, uvs[j], axis, tol.point));
                 if let Some(j) = next.or(prev) {
                     uvs[k][axis] = uvs[j][axis];
                 }
@@ -139,14 +155,23 @@ pub fn project(
         let tm = 0.5 * (t0 + t1);
         let mut m = measure(tm, Some(a))?;
         for axis in 0..2 {
-            if collapsed(s, m, axis, tol) {
+            if collapsed(s, m, axis, tol.point) {
                 m[axis] = 0.5 * (a[axis] + b[axis]);
             }
         }
-        // The chord's error against the projected curve (the curve's own distance from
-        // the surface is the projection error, measured in `measure`).
-        let err = s.point(0.5 * (a + b)).distance(s.point(m));
-        if err > tol && depth < MAX_REFINE {
+        // The chord's distance from the projected curve at `m`: to the chord's point
+        // nearest `m` in the parameter plane, an upper bound of the distance to the
+        // chord's image that does not count where the projection runs faster along the
+        // chord than the curve (an edge running past the surface's end, its projection
+        // stopped there). The curve's own distance from the surface is `gap`.
+        let ab = b - a;
+        let along = if ab.length_squared() > 0.0 {
+            ((m - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let err = s.point(a + along * ab).distance(s.point(m));
+        if err > tol.chord && depth < MAX_REFINE {
             stack.push((tm, m, t1, b, depth + 1));
             stack.push((t0, a, tm, m, depth + 1));
         } else {
@@ -156,7 +181,8 @@ pub fn project(
     }
     Ok(Projected {
         points: out,
-        error: worst.max(chord_worst),
+        gap: worst,
+        chord: chord_worst,
     })
 }
 

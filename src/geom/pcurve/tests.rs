@@ -22,6 +22,11 @@ impl ParamSurface for Cylinder {
     }
 }
 
+/// The same tolerance for chords and for collapsed parameters.
+fn both(t: f64) -> Tolerance {
+    Tolerance { chord: t, point: t }
+}
+
 #[test]
 fn a_helix_crossing_the_seam_stays_continuous() {
     // The helix (r cos t, r sin t, c t) is u = t, v = c t on the cylinder: it crosses the
@@ -29,8 +34,8 @@ fn a_helix_crossing_the_seam_stays_continuous() {
     let (r, c) = (2.0, 0.3);
     let s = Cylinder { r };
     let helix = |t: f64| DVec3::new(r * t.cos(), r * t.sin(), c * t);
-    let p = project(&s, helix, 0.5, 0.5 + 3.0 * TAU, 1e-9).unwrap();
-    assert!(p.error < 1e-12, "{}", p.error);
+    let p = project(&s, helix, 0.5, 0.5 + 3.0 * TAU, both(1e-9)).unwrap();
+    assert!(p.gap.max(p.chord) < 1e-12, "{p:?}");
     assert!((p.points[0] - DVec2::new(0.5, 0.5 * c)).length() < 1e-12);
     for w in p.points.windows(2) {
         assert!(
@@ -47,27 +52,44 @@ fn a_helix_crossing_the_seam_stays_continuous() {
 }
 
 #[test]
-fn a_circle_of_latitude_on_a_nurbs_sphere_lands_on_it() {
-    // A circle at height h on the unit-radius sphere: its projection's chords, mapped back
-    // onto the NURBS, must stay within the tolerance of that circle (closed form: z = h,
-    // distance √(r² − h²) from the axis).
+fn a_tilted_circle_on_a_nurbs_sphere_lands_on_it() {
+    // The circle cut from the sphere of radius r by the plane n · q = h, tilted so that it
+    // follows no iso-line: its projection's chords, mapped back onto the NURBS, must stay
+    // within the tolerance of that plane (closed form; every surface point is on the
+    // sphere, so the plane alone places it on the circle).
     let (r, h) = (1.5, 0.6);
+    let n = DVec3::new(0.3, -0.2, 1.0).normalize();
+    let e1 = n.cross(DVec3::X).normalize();
+    let e2 = n.cross(e1);
     let sphere = shapes::sphere(r).unwrap();
     let target = NurbsTarget::new(&sphere);
     let rho = (r * r - h * h).sqrt();
-    let circle = |t: f64| DVec3::new(rho * t.cos(), rho * t.sin(), h);
+    let circle = |t: f64| h * n + rho * (t.cos() * e1 + t.sin() * e2);
     let tol = 1e-6;
-    let p = project(&target, circle, 0.2, 0.2 + 1.5, tol).unwrap();
-    assert!(p.error <= tol, "{}", p.error);
+    let p = project(&target, circle, 0.2, 0.2 + 1.5, both(tol)).unwrap();
+    assert!(p.gap.max(p.chord) <= tol, "{p:?}");
     assert!(p.points.len() > 5, "refined: {} points", p.points.len());
     for w in p.points.windows(2) {
         for k in 0..=4 {
             let uv = w[0].lerp(w[1], k as f64 / 4.0);
             let q = sphere.eval(uv.x, uv.y);
-            let off = (q.z - h).hypot(q.truncate().length() - rho);
+            let off = (n.dot(q) - h).abs();
             assert!(off <= 2.0 * tol, "{q} is {off} off the circle");
         }
     }
+}
+
+#[test]
+fn a_curve_off_the_surface_is_told_apart_from_the_chords_error() {
+    // A circle of radius r + d about the cylinder's axis lies d from the cylinder of
+    // radius r everywhere (closed form); its projection is the line v = h, whose chords
+    // are exact. The gap must be d, the chord error below the tolerance.
+    let (r, d, h) = (2.0, 3e-3, 0.7);
+    let s = Cylinder { r };
+    let circle = |t: f64| DVec3::new((r + d) * t.cos(), (r + d) * t.sin(), h);
+    let p = project(&s, circle, 0.0, 2.0, both(1e-9)).unwrap();
+    assert!((p.gap - d).abs() < 1e-12, "{p:?}");
+    assert!(p.chord <= 1e-9, "{p:?}");
 }
 
 /// The unit sphere in closed form: `(cos v cos u, cos v sin u, sin v)`, u 2π-periodic,
@@ -95,8 +117,8 @@ fn a_meridian_from_the_pole_keeps_its_longitude() {
     // v = π/2 − t), not whatever atan2(0, 0) gives, or its first chord would cut across.
     let u = 1.0_f64;
     let meridian = |t: f64| Sphere.point(DVec2::new(u, std::f64::consts::FRAC_PI_2 - t));
-    let p = project(&Sphere, meridian, 0.0, 1.5, 1e-9).unwrap();
-    assert!(p.error < 1e-12, "{}", p.error);
+    let p = project(&Sphere, meridian, 0.0, 1.5, both(1e-9)).unwrap();
+    assert!(p.gap.max(p.chord) < 1e-12, "{p:?}");
     for q in &p.points {
         assert!((q.x - u).abs() < 1e-12, "{q}");
     }
@@ -158,8 +180,8 @@ fn iso_lines_of_a_thin_unclamped_closed_tube_project_onto_themselves() {
                 "v = {v}, t = {t}: {uv}"
             );
         }
-        let p = project(&target, line, 0.0, 1.0, 1e-6).unwrap();
-        assert!(p.error < 1e-9, "v = {v}: error {}", p.error);
+        let p = project(&target, line, 0.0, 1.0, both(1e-6)).unwrap();
+        assert!(p.gap.max(p.chord) < 1e-9, "v = {v}: {p:?}");
         assert!(
             (p.points[0] - DVec2::new(0.0, v)).length() < 1e-9,
             "v = {v}"

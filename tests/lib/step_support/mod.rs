@@ -33,6 +33,9 @@ pub struct StepWriter {
     pub unit: Option<(String, f64)>,
     /// Plane-angle unit in degrees instead of radians.
     pub degrees: bool,
+    /// A declared length uncertainty (in the length unit), as CAD systems write their
+    /// modelling tolerance.
+    pub uncertainty: Option<f64>,
 }
 
 impl StepWriter {
@@ -265,8 +268,18 @@ impl StepWriter {
             rad
         };
         let sr = self.add("(NAMED_UNIT(*) SI_UNIT($,.STERADIAN.) SOLID_ANGLE_UNIT())");
+        let uncertainty = match self.uncertainty {
+            None => String::new(),
+            Some(u) => {
+                let m = self.add(format!(
+                    "UNCERTAINTY_MEASURE_WITH_UNIT(LENGTH_MEASURE({}),#{length},'DISTANCE_ACCURACY_VALUE','')",
+                    real(u)
+                ));
+                format!(" GLOBAL_UNCERTAINTY_ASSIGNED_CONTEXT((#{m}))")
+            }
+        };
         let ctx = self.add(format!(
-            "(GEOMETRIC_REPRESENTATION_CONTEXT(3) GLOBAL_UNIT_ASSIGNED_CONTEXT((#{length},#{angle},#{sr})) REPRESENTATION_CONTEXT('',''))"
+            "(GEOMETRIC_REPRESENTATION_CONTEXT(3){uncertainty} GLOBAL_UNIT_ASSIGNED_CONTEXT((#{length},#{angle},#{sr})) REPRESENTATION_CONTEXT('',''))"
         ));
         let origin = self.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
         let mut items = vec![origin, model];

@@ -118,10 +118,12 @@ pub struct Report {
     pub ignored: BTreeMap<i32, usize>,
     /// Surfaces that could not be converted, named by directory sequence number (`D 45`).
     pub failed: Vec<Failure>,
-    /// Trim curves projected from model space, and the largest distance of a projected
-    /// point from the surface.
+    /// Trim curves projected from model space; the largest distance between such a
+    /// curve's trim and its projection onto the surface (this reader's approximation); and
+    /// the largest distance of the curve itself from the surface (the file's own gap).
     pub projected: usize,
-    pub max_projection_error: f64,
+    pub max_trim_error: f64,
+    pub max_curve_gap: f64,
     /// Surfaces (directory sequence numbers) whose parameter-space trim curves lay far
     /// from their model-space curves, which were drawn instead, and the largest distance.
     pub strayed: Vec<usize>,
@@ -145,9 +147,10 @@ impl Report {
         )];
         if self.projected > 0 {
             out.push(format!(
-                "IGES trim curves projected from model space: {} (largest projection error {:e} mm)",
+                "IGES trim curves projected from model space: {}; their trims within {:.3e} mm of the projected curves, which lie up to {:.3e} mm from their surfaces",
                 self.projected,
-                self.max_projection_error * self.unit.millimetres
+                self.max_trim_error * self.unit.millimetres,
+                self.max_curve_gap * self.unit.millimetres
             ));
         }
         if let Some(first) = self.strayed.first() {
@@ -313,7 +316,8 @@ pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
         ignored: BTreeMap::new(),
         failed: Vec::new(),
         projected: 0,
-        max_projection_error: 0.0,
+        max_trim_error: 0.0,
+        max_curve_gap: 0.0,
         strayed: Vec::new(),
         max_stray: 0.0,
     };

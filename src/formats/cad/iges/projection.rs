@@ -6,7 +6,7 @@
 use glam::{DVec2, DVec3};
 
 use super::trimmed::CLOSED;
-use crate::formats::cad::CHORD_TOLERANCE;
+use crate::formats::cad::projection_tolerance;
 use crate::geom::bezier::ParamRect;
 use crate::geom::nurbs::NurbsSurface;
 use crate::geom::pcurve::{self, NurbsTarget, ParamSurface};
@@ -19,8 +19,8 @@ pub(super) struct Target<'s> {
     nurbs: NurbsTarget<'s>,
     domain: ParamRect,
     periods: [Option<f64>; 2],
-    /// The projection's chord tolerance, `pcurve`'s refinement bound.
-    pub(super) tolerance: f64,
+    /// The projection's tolerances, relative to the surface's net.
+    pub(super) tolerance: pcurve::Tolerance,
 }
 
 impl<'s> Target<'s> {
@@ -38,7 +38,7 @@ impl<'s> Target<'s> {
                 closed[0].then_some(d.u1 - d.u0),
                 closed[1].then_some(d.v1 - d.v0),
             ],
-            tolerance: CHORD_TOLERANCE * size,
+            tolerance: projection_tolerance(size),
         }
     }
 
@@ -113,7 +113,7 @@ impl Target<'_> {
                 for k in 0..2 {
                     let by = pcurve::unwrap(points[0][k], prev[k], self.periods[k]) - points[0][k];
                     points.iter_mut().for_each(|p| p[k] += by);
-                    if pcurve::collapsed(self, prev, k, self.tolerance) {
+                    if pcurve::collapsed(self, prev, k, self.tolerance.point) {
                         after_pole[k] = Some(i);
                     }
                 }

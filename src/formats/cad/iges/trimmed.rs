@@ -297,7 +297,8 @@ fn with_loops(
                     target.tolerance,
                 )
                 .map_err(|p| format!("the model-space trim point {p} could not be projected"))?;
-                report.max_projection_error = report.max_projection_error.max(projected.error);
+                report.max_trim_error = report.max_trim_error.max(projected.chord);
+                report.max_curve_gap = report.max_curve_gap.max(projected.gap);
                 if projected.points.len() >= 2 {
                     parts.push(Part::Projected(projected.points));
                 }

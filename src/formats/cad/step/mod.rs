@@ -39,6 +39,7 @@ use rayon::prelude::*;
 use self::entities::Resolver;
 use self::style::Colour;
 use self::units::Units;
+use super::POINT_TOLERANCE;
 use super::scene::{self, CadModel, DeclaredUnit, Failure, Part, Piece, Shape};
 use crate::formats::error::{LoadError, ParseError};
 use crate::scene::model::{Material, Object, TriangleMesh};
@@ -59,10 +60,21 @@ pub struct Report {
     pub failed_faces: Vec<(u64, String)>,
     /// Entities left unread, by type.
     pub unsupported: BTreeMap<String, usize>,
-    /// Edges projected into their face's domain (no usable pcurve) and the largest
-    /// distance between such an edge and its trim, in millimetres.
+    /// Edges projected into their face's domain (no usable pcurve).
     pub projected_edges: usize,
-    pub max_projection_error: f64,
+    /// The largest distance between a projected edge's trim and the edge's projection onto
+    /// the surface (this reader's approximation), in millimetres, and the size of the
+    /// faces' extent, which it is relative to.
+    pub max_trim_error: f64,
+    pub model_size: f64,
+    /// Projected edges farther from a face's surface than [`Report::edge_tolerance`]:
+    /// `(edge #id, face #id, distance in millimetres)`, the farthest first. Their trims
+    /// follow the edge's projection onto the surface, as OpenCASCADE's healing does.
+    pub far_edges: Vec<(u64, u64, f64)>,
+    /// The distance within which an edge counts as on its face, in millimetres: the
+    /// file's declared uncertainty, or [`POINT_TOLERANCE`] of the model where it declares
+    /// none.
+    pub edge_tolerance: f64,
     /// Faces kept with a projected edge farther from their surface than a pcurve may stray
     /// from its edge (the edge is not on the surface, or its projection failed), and that
     /// distance, in millimetres: `(#id, distance)`.
@@ -100,10 +112,24 @@ impl Report {
                 self.colours
             ),
             format!(
-                "projected edges: {}, largest projection error {:.3e} mm",
-                self.projected_edges, self.max_projection_error
+                "projected edges (no usable pcurve): {}; their trims within {:.3e} mm of the projected edges ({:.2e} of the model's size)",
+                self.projected_edges,
+                self.max_trim_error,
+                self.max_trim_error / self.model_size
             ),
         ];
+        if let Some(&(edge, face, d)) = self.far_edges.first() {
+            lines.push(format!(
+                "edges farther from their face than the file's tolerance ({:.3e} mm{}): {}, up to {d:.3e} mm (edge #{edge} on face #{face}); trimmed along their projection",
+                self.edge_tolerance,
+                if self.units.uncertainty.is_some() {
+                    ", declared"
+                } else {
+                    ", none declared: 1e-5 of the model"
+                },
+                self.far_edges.len()
+            ));
+        }
         if self.surfaces > 0 {
             lines.push(format!(
                 "surfaces outside faces: {} converted (geometric sets, surface models)",
@@ -288,12 +314,26 @@ pub fn read_model(path: &Path, src: &str) -> Result<(CadModel, Report), ParseErr
         .map(|(id, source)| (id, convert(source, size)))
         .collect();
     let mut converted: HashMap<u64, Shape> = HashMap::new();
+    let factor = report.units.length.factor;
+    report.model_size = size * factor;
+    report.edge_tolerance = report
+        .units
+        .uncertainty
+        .unwrap_or(POINT_TOLERANCE * report.model_size);
+    let mut projected: HashMap<u64, (u64, f64)> = HashMap::new();
     for (id, outcome) in outcomes {
         if let Ok(Converted::Face(out) | Converted::Surface(out)) = &outcome {
-            report.projected_edges += out.projected_edges;
-            report.max_projection_error = report.max_projection_error.max(out.projection_error);
-            if out.projection_error > size * topology::PCURVE_TOLERANCE {
-                report.stray_projections.push((id, out.projection_error));
+            report.max_trim_error = report.max_trim_error.max(out.trim_error * factor);
+            let mut worst = out.trim_error;
+            for &(edge, gap) in &out.edge_gaps {
+                worst = worst.max(gap);
+                let farthest = projected.entry(edge).or_insert((id, gap));
+                if gap > farthest.1 {
+                    *farthest = (id, gap);
+                }
+            }
+            if worst > size * topology::PCURVE_TOLERANCE {
+                report.stray_projections.push((id, worst));
             }
         }
         match outcome {
@@ -314,7 +354,15 @@ pub fn read_model(path: &Path, src: &str) -> Result<(CadModel, Report), ParseErr
         }
     }
     report.failed_faces.sort_by_key(|(id, _)| *id);
-    report.max_projection_error *= report.units.length.factor;
+    report.projected_edges = projected.len();
+    report.far_edges = projected
+        .into_iter()
+        .map(|(edge, (face, gap))| (edge, face, gap * factor))
+        .filter(|&(_, _, d)| d > report.edge_tolerance)
+        .collect();
+    report
+        .far_edges
+        .sort_by(|a, b| b.2.total_cmp(&a.2).then(a.0.cmp(&b.0)));
     report.stray_projections.sort_by_key(|(id, _)| *id);
     for (_, d) in &mut report.stray_projections {
         *d *= report.units.length.factor;
@@ -419,8 +467,8 @@ fn convert(source: Source, size: f64) -> Result<Converted, String> {
         Source::Standalone(surfaces::Standalone::Patch(p)) => {
             Converted::Surface(topology::FaceOutcome {
                 surface: surfaces::convert_patch(&p)?,
-                projection_error: 0.0,
-                projected_edges: 0,
+                trim_error: 0.0,
+                edge_gaps: Vec::new(),
             })
         }
         Source::Mesh(m) if m.indices.is_empty() => return Err("it holds no triangle".into()),

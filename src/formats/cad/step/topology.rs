@@ -25,7 +25,7 @@ use glam::{DVec2, DVec3};
 use super::entities::{Curve, Edge, Face, PCurve, SurfaceDef};
 use super::geometry::{curve_to_nurbs, surface_to_nurbs};
 use super::loop_piece::{Piece, as_param};
-use crate::formats::cad::CHORD_TOLERANCE;
+use crate::formats::cad::{POINT_TOLERANCE, projection_tolerance};
 use crate::geom::nurbs::NurbsSurface;
 use crate::geom::nurbs::inversion::Inverter;
 use crate::geom::pcurve::{self, ParamSurface, unwrap};
@@ -39,10 +39,12 @@ pub(super) const PCURVE_TOLERANCE: f64 = 1e-4;
 /// A converted face and what its conversion measured.
 pub struct FaceOutcome {
     pub surface: Surface,
-    /// Largest distance between a projected edge and its image in the domain.
-    pub projection_error: f64,
-    /// Edges whose pieces came from projection rather than a pcurve.
-    pub projected_edges: usize,
+    /// Largest distance between a projected edge's trim and the edge's projection onto
+    /// the surface: this reader's approximation.
+    pub trim_error: f64,
+    /// The edges whose pieces came from projection rather than a pcurve, each with its
+    /// largest distance from the surface: the file's own gap between edge and face.
+    pub edge_gaps: Vec<(u64, f64)>,
 }
 
 /// The face's surface as far as the loops need it: its definition, its periods, and a
@@ -92,15 +94,20 @@ impl Domain<'_> {
     /// Whether the periodic u collapses at `uv` (a sphere's pole, a cone's apex), where the
     /// angle of a point means nothing.
     fn collapsed_u(&self, uv: DVec2) -> bool {
-        pcurve::collapsed(self, uv, 0, self.scale * CHORD_TOLERANCE)
+        pcurve::collapsed(self, uv, 0, self.scale * POINT_TOLERANCE)
     }
 
     /// The projection of `c` over `[ta, tb]` into the parameter plane (`geom::pcurve`),
-    /// its chords within [`CHORD_TOLERANCE`] of the model.
-    fn project(&self, c: &Curve, ta: f64, tb: f64) -> Result<(Vec<DVec2>, f64), String> {
-        pcurve::project(self, |t| c.point(t), ta, tb, self.scale * CHORD_TOLERANCE)
-            .map(|p| (p.points, p.error))
-            .map_err(|p| format!("cannot project the edge point {p} onto the surface"))
+    /// its chords within [`CHORD_TOLERANCE`](crate::formats::cad::CHORD_TOLERANCE) of the model.
+    fn project(&self, c: &Curve, ta: f64, tb: f64) -> Result<pcurve::Projected, String> {
+        pcurve::project(
+            self,
+            |t| c.point(t),
+            ta,
+            tb,
+            projection_tolerance(self.scale),
+        )
+        .map_err(|p| format!("cannot project the edge point {p} onto the surface"))
     }
 
     /// The pcurve `pc` over `[ta, tb]`, exact, if it agrees with the 3D curve there (its
@@ -238,7 +245,7 @@ fn close_gap(dom: &Domain, prev: &mut Piece, next: &mut Piece) -> Option<Piece> 
     if gap <= 1e-9 * (1.0 + end.length()) {
         return None;
     }
-    let one_point = dom.point(end).distance(dom.point(start)) <= dom.scale * CHORD_TOLERANCE;
+    let one_point = dom.point(end).distance(dom.point(start)) <= dom.scale * POINT_TOLERANCE;
     let short = |p: &Piece| gap <= SHORT_GAP * p.start().distance(p.end());
     if one_point
         && short(prev)
@@ -385,8 +392,8 @@ fn whole_face(face: &Face) -> Result<FaceOutcome, String> {
     }
     Ok(FaceOutcome {
         surface,
-        projection_error: 0.0,
-        projected_edges: 0,
+        trim_error: 0.0,
+        edge_gaps: Vec::new(),
     })
 }
 
@@ -414,7 +421,7 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
         _ => None,
     };
     let periods = match def {
-        SurfaceDef::BSpline(n) => closed_periods(n, scale * CHORD_TOLERANCE),
+        SurfaceDef::BSpline(n) => closed_periods(n, scale * POINT_TOLERANCE),
         _ => def.periods(),
     };
     let dom = Domain {
@@ -423,8 +430,8 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
         inverter,
         scale,
     };
-    let mut projection_error: f64 = 0.0;
-    let mut projected_edges = 0;
+    let mut trim_error: f64 = 0.0;
+    let mut edge_gaps = Vec::new();
     // Each edge's candidate pieces, once per face (a seam edge appears twice in a loop).
     let mut candidates: HashMap<u64, Vec<TrimSegment>> = HashMap::new();
     if face.bounds.iter().all(|b| b.edges.is_empty()) {
@@ -475,12 +482,12 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
                     list.push(seg);
                 }
                 if list.is_empty() {
-                    let (points, err) = dom
+                    let projected = dom
                         .project(c3, ta, tb)
                         .map_err(|m| format!("edge #{}: {m}", e.id))?;
-                    projection_error = projection_error.max(err);
-                    projected_edges += 1;
-                    list.push(TrimSegment::polyline(&points));
+                    trim_error = trim_error.max(projected.chord);
+                    edge_gaps.push((e.id, projected.gap));
+                    list.push(TrimSegment::polyline(&projected.points));
                 }
                 slot.insert(list);
             }
@@ -728,7 +735,7 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
     }
     Ok(FaceOutcome {
         surface,
-        projection_error,
-        projected_edges,
+        trim_error,
+        edge_gaps,
     })
 }

@@ -4,7 +4,7 @@
 //! revolution and conic trims are written.
 
 use super::entities::Resolver;
-use super::records::{Instance, Value};
+use super::records::{Instance, Record, Value};
 
 /// A length or plane-angle unit: its name and its size in millimetres or radians.
 #[derive(Clone, Debug, PartialEq)]
@@ -13,11 +13,15 @@ pub struct Unit {
     pub factor: f64,
 }
 
-/// The units of one context.
+/// The units of one context, and the distance within which it declares two points one.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Units {
     pub length: Unit,
     pub angle: Unit,
+    /// The context's length uncertainty in millimetres (ISO 10303-43 §4.2.2
+    /// GLOBAL_UNCERTAINTY_ASSIGNED_CONTEXT: an UNCERTAINTY_MEASURE_WITH_UNIT of a length
+    /// unit, the largest if it gives several), where the file declares one.
+    pub uncertainty: Option<f64>,
 }
 
 impl Default for Units {
@@ -33,6 +37,7 @@ impl Default for Units {
                 name: "radian (assumed)".into(),
                 factor: 1.0,
             },
+            uncertainty: None,
         }
     }
 }
@@ -106,15 +111,7 @@ fn unit_size(res: &Resolver, inst: &Instance, depth: usize) -> Option<Unit> {
         .records
         .iter()
         .find(|r| r.name.ends_with("MEASURE_WITH_UNIT"))?;
-    let value = match &r.params.first()?.value {
-        Value::Typed(_, inner) => match inner.value {
-            Value::Real(x) => x,
-            Value::Integer(i) => i as f64,
-            _ => return None,
-        },
-        Value::Real(x) => *x,
-        _ => return None,
-    };
+    let value = measure_value(r)?;
     let Value::Ref(base) = r.params.get(1)?.value else {
         return None;
     };
@@ -123,15 +120,51 @@ fn unit_size(res: &Resolver, inst: &Instance, depth: usize) -> Option<Unit> {
     (factor.is_finite() && factor > 0.0).then_some(Unit { name, factor })
 }
 
+/// The value of a `*_MEASURE_WITH_UNIT` record's first parameter (typed or bare).
+fn measure_value(r: &Record) -> Option<f64> {
+    match &r.params.first()?.value {
+        Value::Typed(_, inner) => match inner.value {
+            Value::Real(x) => Some(x),
+            Value::Integer(i) => Some(i as f64),
+            _ => None,
+        },
+        Value::Real(x) => Some(*x),
+        _ => None,
+    }
+}
+
+/// The largest length uncertainty the context `ctx` assigns, in millimetres.
+fn context_uncertainty(res: &Resolver, ctx: &Instance) -> Option<f64> {
+    let guac = ctx.record("GLOBAL_UNCERTAINTY_ASSIGNED_CONTEXT")?;
+    let Some(Value::List(list)) = guac.params.first().map(|p| &p.value) else {
+        return None;
+    };
+    list.iter()
+        .filter_map(|item| {
+            let Value::Ref(id) = item.value else {
+                return None;
+            };
+            let r = res.ex.get(id)?.record("UNCERTAINTY_MEASURE_WITH_UNIT")?;
+            let Value::Ref(unit) = r.params.get(1)?.value else {
+                return None;
+            };
+            let unit = res.ex.get(unit)?;
+            unit.record("LENGTH_UNIT")?;
+            let mm = measure_value(r)? * unit_size(res, unit, 0)?.factor;
+            (mm.is_finite() && mm > 0.0).then_some(mm)
+        })
+        .reduce(f64::max)
+}
+
 /// The units assigned by the context `ctx` (GLOBAL_UNIT_ASSIGNED_CONTEXT, usually one
 /// record of a complex context instance); what is missing keeps the default.
 pub fn context_units(res: &Resolver, ctx: u64) -> Units {
     let mut units = Units::default();
-    let Some(gua) = res
-        .ex
-        .get(ctx)
-        .and_then(|c| c.record("GLOBAL_UNIT_ASSIGNED_CONTEXT"))
-    else {
+    let Some(context) = res.ex.get(ctx) else {
+        return units;
+    };
+    units.uncertainty = context_uncertainty(res, context);
+    let Some(gua) = context.record("GLOBAL_UNIT_ASSIGNED_CONTEXT") else {
         return units;
     };
     let Some(Value::List(list)) = gua.params.first().map(|p| &p.value) else {
