@@ -49,6 +49,17 @@ for mode, name in [(0,"faces"),(1,"brep")]:
     iw.AddShape(part)
     iw.ComputeModel()
     iw.Write(f"/tmp/occparts/bracket_occ_{name}.igs")
+# the same part in inches, as STEP (a CONVERSION_BASED_UNIT 'INCH') and IGES faces
+# (Global parameters 14, 15: 4, INCH)
+Interface_Static.SetCVal_s("write.step.unit", "INCH")
+w = STEPControl_Writer()
+w.Transfer(part, STEPControl_AsIs)
+w.Write("/tmp/occparts/bracket_occ_inch.step")
+Interface_Static.SetCVal_s("write.step.unit", "MM")
+iw = IGESControl_Writer("IN", 0)
+iw.AddShape(part)
+iw.ComputeModel()
+iw.Write("/tmp/occparts/bracket_occ_inch.igs")
 # a torus and a cone as their own files
 t = BRepPrimAPI_MakeTorus(gp_Ax2(gp_Pnt(0,0,0), gp_Dir(0,0,1)), 10, 3).Shape()
 c = BRepPrimAPI_MakeCone(gp_Ax2(gp_Pnt(30,0,0), gp_Dir(0,0,1)), 6, 2, 8).Shape()

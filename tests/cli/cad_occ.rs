@@ -174,6 +174,15 @@ fn occ_iges_brep_part_hits_every_face_kind_and_passes_its_holes() {
     check("occ/bracket_occ_brep.igs", false);
 }
 
+#[test]
+fn occ_inch_step_and_iges_come_out_where_the_millimetre_part_is() {
+    // The same part written in inches: read in millimetres, both hit the closed-form
+    // points of the part's millimetre dimensions, so they render to the same size and
+    // place as each other and as the millimetre files.
+    check("occ/bracket_occ_inch.step", true);
+    check("occ/bracket_occ_inch.igs", false);
+}
+
 /// OpenCASCADE's assembly of the bracket used three times (XCAF components, turned by 0°,
 /// 90° and 180° about z and moved): three instances of one shared part, and the vertical
 /// aims (which cannot reach another copy) hit each placed copy where the placement puts
