@@ -66,6 +66,9 @@ c = BRepPrimAPI_MakeCone(gp_Ax2(gp_Pnt(30,0,0), gp_Dir(0,0,1)), 6, 2, 8).Shape()
 both = BRepAlgoAPI_Fuse(t, c).Shape()
 w = STEPControl_Writer(); w.Transfer(both, STEPControl_AsIs); w.Write("/tmp/occparts/torus_cone_occ.step")
 iw = IGESControl_Writer("MM", 0); iw.AddShape(both); iw.ComputeModel(); iw.Write("/tmp/occparts/torus_cone_occ.igs")
+# and as an IGES B-rep (186 solids over 198 torus and 194 cone entities)
+Interface_Static.SetIVal_s("write.iges.brep.mode", 1)
+iw = IGESControl_Writer("MM", 1); iw.AddShape(both); iw.ComputeModel(); iw.Write("/tmp/occparts/torus_cone_occ_brep.igs")
 # an assembly: the bracket used three times (XCAF components with their own locations), as
 # a CAD system writes a product structure; STEP and IGES (308/408 subfigures) from it
 from OCP.TDocStd import TDocStd_Document

@@ -212,6 +212,62 @@ fn occ_step_assembly_places_three_instances_of_one_part() {
     check_placed("occ/brackets3_occ.step", true, vertical, &placements);
 }
 
+/// Rays along the outward normal at (u, v) of the torus (R 10, r 3, axis z) and the cone
+/// frustum (base r 6 at (30, 0, 0), top r 2 at height 8) of `torus_cone_occ_brep.igs`,
+/// with the points in closed form; two rays just above the frustum's top pass beside or
+/// hit the top plane, where a cone running on past it (its height read as the length
+/// along its side) would be hit first.
+fn torus_cone_aims() -> Vec<Aim> {
+    let aim = |name, origin, dir, hit| Aim {
+        name,
+        origin,
+        dir,
+        hit,
+    };
+    let mut aims = Vec::new();
+    for (u, v) in [(0.3, 0.2), (2.0, -1.1), (4.0, 1.3), (5.5, 0.0)] {
+        let (cu, su) = (f64::cos(u), f64::sin(u));
+        let (cv, sv) = (f64::cos(v), f64::sin(v));
+        let p = DVec3::new((10.0 + 3.0 * cv) * cu, (10.0 + 3.0 * cv) * su, 3.0 * sv);
+        let n = DVec3::new(cv * cu, cv * su, sv);
+        aims.push(aim("torus", p + 25.0 * n, -n, Some((p, n))));
+    }
+    for (u, h) in [(0.5, 1.0), (2.5, 4.0), (4.5, 7.5)] {
+        let r = 6.0 - 0.5 * h;
+        let (cu, su) = (f64::cos(u), f64::sin(u));
+        let p = DVec3::new(30.0 + r * cu, r * su, h);
+        let n = DVec3::new(cu, su, 0.5).normalize();
+        aims.push(aim("cone", p + 25.0 * n, -n, Some((p, n))));
+    }
+    let top = DVec3::new(31.8, 0.0, 8.0);
+    aims.push(aim(
+        "cone's top",
+        top + 20.0 * DVec3::Z,
+        -DVec3::Z,
+        Some((top, DVec3::Z)),
+    ));
+    aims.push(aim(
+        "above the cone's top",
+        DVec3::new(60.0, 0.0, 8.3),
+        -DVec3::X,
+        None,
+    ));
+    aims
+}
+
+#[test]
+fn occ_iges_brep_torus_and_cone_take_its_parameter_conventions() {
+    // OpenCASCADE writes a 198 torus's parameter-space curves in degrees with u and v
+    // exchanged and turned, and a 194 cone's v along its side; read as IGES 5.3 says, the
+    // torus was refused and the cone ran past its top.
+    check_placed(
+        "occ/torus_cone_occ_brep.igs",
+        false,
+        torus_cone_aims(),
+        &[DAffine3::IDENTITY],
+    );
+}
+
 /// Found by the mutation run (`benches/mutation_run.rs`): OpenCASCADE's two-solid file with
 /// one part's shape representation deleted made the assembly walk look up a product that
 /// had none, and panic. That part now places nothing; the other part's 3 faces still load.

@@ -736,7 +736,11 @@ fn catia_s_key_projects_its_edges_within_tolerance() {
         "{:?}",
         m.report.failed_faces
     );
-    assert!(m.report.projected_edges > 80, "{}", m.report.projected_edges);
+    assert!(
+        m.report.projected_edges > 80,
+        "{}",
+        m.report.projected_edges
+    );
     assert!(m.report.model_size < 200.0, "{} mm", m.report.model_size);
     assert!(
         m.report.max_trim_error <= 1e-6 * m.report.model_size,

@@ -222,7 +222,10 @@ fn info_reports_units_faces_and_projections() {
     // Projected: fillet circles and seam (3), wall bottom and top circles (2, the seam
     // has pcurves), the B-spline bottom's square and circle (5). The planes' edges (top
     // square and circle, the sides) map exactly through the plane's frame.
-    assert!(out.contains("projected edges (no usable pcurve): 10;"), "{out}");
+    assert!(
+        out.contains("projected edges (no usable pcurve): 10;"),
+        "{out}"
+    );
     // Loops: top 2, fillet 1, wall 1, bottom 2, sides 4.
     assert!(out.contains("10 trim loop(s)"), "{out}");
 }

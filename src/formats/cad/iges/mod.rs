@@ -40,10 +40,11 @@ use crate::scene::model::Surface;
 pub struct Model {
     pub entries: Vec<DirEntry>,
     pub entities: Vec<Entity>,
-    /// The parameter-space curves on 192–196 give their angles in degrees: files written
-    /// by OpenCASCADE, whose IGES writer and reader (`IGESToBRep_TopoSurface::ParamSurface`)
-    /// scale the angles of cylinders, cones (u) and spheres (u and v) by 180/π; the 5.3
-    /// text read here gives radians.
+    /// The parameter-space curves on 192–198 follow OpenCASCADE's parameterisations:
+    /// files written by it, whose IGES writer and reader
+    /// (`IGESToBRep_TopoSurface::ParamSurface`) scale the angles of cylinders, cones (u),
+    /// spheres and tori by 180/π, measure a cone's v along its side and exchange a torus's
+    /// u and v; the 5.3 text read here gives radians and the height along the axis.
     pub angles_in_degrees: bool,
 }
 

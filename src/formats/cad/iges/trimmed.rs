@@ -275,7 +275,9 @@ fn with_loops(
     for l in loops {
         let mut parts = Vec::new();
         for e in &l.edges {
-            if let Some(s) = parameter_segments(model, l.model_preferred, e, c.to_trim)? {
+            if let Some(s) =
+                parameter_segments(model, l.model_preferred, e, UvMap::axes(c.to_trim))?
+            {
                 let off = if e.model == 0 {
                     0.0
                 } else {
@@ -382,6 +384,27 @@ fn err(e: impl std::fmt::Display) -> String {
     e.to_string()
 }
 
+/// An affine map of the parameter plane: `u' = m[0] · (u, v, 1)`, `v' = m[1] · (u, v, 1)`,
+/// applied exactly to homogeneous points.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct UvMap([[f64; 3]; 2]);
+
+impl UvMap {
+    /// Each parameter scaled and moved on its own: `(scale, offset)` for u and for v.
+    fn axes([(su, ou), (sv, ov)]: [(f64, f64); 2]) -> UvMap {
+        UvMap([[su, 0.0, ou], [0.0, sv, ov]])
+    }
+
+    fn apply(&self, q: DVec3) -> DVec3 {
+        let [a, b] = self.0;
+        DVec3::new(
+            a[0] * q.x + a[1] * q.y + a[2] * q.z,
+            b[0] * q.x + b[1] * q.y + b[2] * q.z,
+            q.z,
+        )
+    }
+}
+
 /// The parameter-space curves of an edge as trim segments (the affine `to_trim` applied,
 /// exact on the homogeneous points), or `None` where the model-space curve is to be used:
 /// there are none, or the model-space curve is preferred and present.
@@ -389,7 +412,7 @@ fn parameter_segments(
     model: &Model,
     model_preferred: bool,
     e: &Edge,
-    [(su, ou), (sv, ov)]: [(f64, f64); 2],
+    to_trim: UvMap,
 ) -> Result<Option<Vec<TrimSegment>>, String> {
     if e.parameter.is_empty() || (model_preferred && e.model != 0) {
         if e.model == 0 {
@@ -412,7 +435,7 @@ fn parameter_segments(
                         .curve
                         .points
                         .iter()
-                        .map(|q| DVec3::new(su * q.x + ou * q.w, sv * q.y + ov * q.w, q.w))
+                        .map(|q| to_trim.apply(DVec3::new(q.x, q.y, q.w)))
                         .collect(),
                 },
             });
@@ -461,6 +484,28 @@ fn samples(piece: &Piece) -> Vec<DVec3> {
     points
 }
 
+/// The map from the parameter-space curves OpenCASCADE writes on a 190–198 surface to the
+/// standard's parameters, the inverse of what its writer applies and what its reader
+/// undoes (`IGESToBRep_TopoSurface::ParamSurface`; see `Model`): angles in degrees (a
+/// cylinder's and cone's u, both of a sphere's); a cone's v along its generatrix, as its
+/// `Geom_ConicalSurface` measures it, where IGES 5.3 §4.41 measures height along the axis
+/// (v cos α); a torus's parameters exchanged and turned, (a, b) written for
+/// (360° − b, a).
+fn opencascade_parameters(placed: &Placed) -> UvMap {
+    let degree = std::f64::consts::PI / 180.0;
+    match placed.shape {
+        Elementary::Plane => UvMap::axes([(1.0, 0.0), (1.0, 0.0)]),
+        Elementary::Cylinder { .. } => UvMap::axes([(degree, 0.0), (1.0, 0.0)]),
+        Elementary::Cone { semi_angle, .. } => {
+            UvMap::axes([(degree, 0.0), ((semi_angle * degree).cos(), 0.0)])
+        }
+        Elementary::Sphere { .. } => UvMap::axes([(degree, 0.0), (degree, 0.0)]),
+        Elementary::Torus { .. } => {
+            UvMap([[0.0, -degree, std::f64::consts::TAU], [degree, 0.0, 0.0]])
+        }
+    }
+}
+
 /// A 190–198 surface over the box of its loops. Parameter-space curves apply as written
 /// (the trim parameters are the standard's); model-space curves are mapped to parameters
 /// in closed form, angles unwrapped along the curve so a loop crossing the seam stays
@@ -473,18 +518,10 @@ fn analytic_with_loops(
     let plane = matches!(placed.shape, Elementary::Plane);
     let frame = placed_frame(placed);
     let angular = placed.angular();
-    // Parameter-space angles in degrees (OpenCASCADE's convention, see `Model`) become
-    // radians: a scale of the homogeneous points, exact.
-    let degree = std::f64::consts::PI / 180.0;
-    let units = if model.angles_in_degrees {
-        if matches!(placed.shape, Elementary::Torus { .. }) {
-            return Err("a torus written by OpenCASCADE (parameters in degrees, u and v exchanged) is not read yet".into());
-        }
-        // The sphere's latitude too, though it is not periodic.
-        let sphere = matches!(placed.shape, Elementary::Sphere { .. });
-        [angular[0], angular[1] || sphere].map(|a| (if a { degree } else { 1.0 }, 0.0))
+    let to_trim = if model.angles_in_degrees {
+        opencascade_parameters(placed)
     } else {
-        [(1.0, 0.0), (1.0, 0.0)]
+        UvMap::axes([(1.0, 0.0), (1.0, 0.0)])
     };
     let mut trims = Vec::new();
     for l in loops {
@@ -493,7 +530,7 @@ fn analytic_with_loops(
             // Form 0 has no parameterisation the writer and this reader share: its
             // parameter-space curves are the last resort.
             let prefer_model = l.model_preferred || !placed.parameterised;
-            if let Some(s) = parameter_segments(model, prefer_model, e, units)? {
+            if let Some(s) = parameter_segments(model, prefer_model, e, to_trim)? {
                 segments.extend(s);
                 continue;
             }
