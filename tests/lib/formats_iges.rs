@@ -284,6 +284,108 @@ fn b_spline_surface_with_transform_colour_and_parameter_space_trims() {
     }
 }
 
+/// The square-trimmed 128 of `b_spline_surface_with_transform_colour_and_parameter_space_trims`
+/// without transform and hole: 0: 128, 1–4: 110 lines of the square (0.1..0.9)² in (u, v),
+/// 5: 102, 6: 142 (parameter-space curve only), 7: 144.
+fn square_trimmed(n: &Net) -> Vec<Ent> {
+    let square = [(0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.1, 0.9), (0.1, 0.1)];
+    let mut ents = vec![ent(128, &b128(n, [0.0, 1.0, 0.0, 1.0]))];
+    for w in square.windows(2) {
+        ents.push(ent(110, &[w[0].0, w[0].1, 0.0, w[1].0, w[1].1, 0.0]));
+    }
+    ents.push(ent(102, &[4.0, de(1), de(2), de(3), de(4)]));
+    ents.push(ent(142, &[0.0, de(0), de(5), 0.0, 1.0]));
+    let mut top = ent(144, &[de(0), 1.0, 0.0, de(6)]);
+    top.subordinate = 0;
+    ents.push(top);
+    ents
+}
+
+/// The surface and its outer loop's corners against the closed forms: the net, and the
+/// square (0.1..0.9)² in (u, v).
+fn assert_square_trimmed(n: &Net, read: &Iges) {
+    let (nurbs, surface) = only(read);
+    for (u, v) in grid() {
+        close(nurbs.eval(u, v), net_point(n, u, v), 8.0, "128");
+    }
+    let [outer]: &[TrimLoop; 1] = surface.trims.as_slice().try_into().unwrap();
+    let corners: Vec<DVec2> = outer
+        .segments
+        .iter()
+        .map(|seg| trim_point(&seg.curve, seg.t0))
+        .collect();
+    let want = [(0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.1, 0.9)].map(DVec2::from);
+    assert_eq!(corners.len(), 4, "{corners:?}");
+    for (c, w) in corners.iter().zip(want) {
+        assert!((*c - w).length() < REL, "{c} against {w}");
+    }
+}
+
+#[test]
+fn miscounted_parameter_lines_and_blanked_surfaces_read_as_opencascade_reads_them() {
+    // Rhino 98 writes directory parameter line counts that are not the entity's (20 for
+    // a 128 on 7 records); CATIA V4 blanks every surface of some files. Each parameter
+    // record names its entity (columns 65–72), and OpenCASCADE draws blanked entities.
+    let n = net();
+    let ents = square_trimmed(&n);
+    let entries: Vec<Entry> = ents
+        .iter()
+        .map(|e| Entry {
+            ty: e.ty,
+            form: e.form,
+            fields: e.params.clone(),
+            transform: e.transform,
+            colour: e.colour,
+            // The 144 blanked (status digits 1–2: 01).
+            status: format!("{:02}{:02}0000", u8::from(e.ty == 144), e.subordinate),
+        })
+        .collect();
+    let text = fixed_format(GLOBAL, &entries);
+    // The second directory record of each entity: its parameter line count in columns
+    // 25–32. The 128's made too large, the first 110's too small.
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let mut patched = 0;
+    for l in lines.iter_mut() {
+        let seq: usize = l[73..].trim().parse().unwrap_or(0);
+        if l.as_bytes()[72] == b'D' && (seq == 2 || seq == 4) {
+            let count = if seq == 2 { 20 } else { 0 };
+            l.replace_range(24..32, &format!("{count:>8}"));
+            patched += 1;
+        }
+    }
+    assert_eq!(patched, 2);
+    let text = lines.join("\n") + "\n";
+    let read = parse_iges(Path::new("test.igs"), &text).unwrap_or_else(|e| panic!("{e}"));
+    assert_square_trimmed(&n, &read);
+    assert_eq!(read.report.blanked, 1);
+    assert!(
+        read.report
+            .warnings
+            .iter()
+            .any(|w| w.contains("2 entities whose directory parameter line count disagrees")),
+        "{:?}",
+        read.report.warnings
+    );
+}
+
+#[test]
+fn a_model_space_curve_off_its_surface_leaves_the_parameter_space_curve() {
+    // Both curves given, disagreeing; the model-space one (the square 100 above the
+    // surface) does not lie on the surface, so it cannot stand for the boundary.
+    let n = net();
+    let mut ents = square_trimmed(&n);
+    let lifted = [(0.1, 0.1), (0.9, 0.1), (0.9, 0.9), (0.1, 0.9), (0.1, 0.1)];
+    for w in lifted.windows(2) {
+        ents.push(ent(110, &[w[0].0, w[0].1, 100.0, w[1].0, w[1].1, 100.0]));
+    }
+    ents.push(ent(102, &[4.0, de(8), de(9), de(10), de(11)]));
+    ents[6] = ent(142, &[0.0, de(0), de(5), de(12), 1.0]);
+    let read = read(&ents);
+    assert_square_trimmed(&n, &read);
+    assert_eq!(read.report.off_surface, [25], "the 102 at D 25 is named");
+    assert_eq!(read.report.projected, 0);
+}
+
 #[test]
 fn narrower_parameter_range_becomes_an_outer_loop_and_units_are_read() {
     let n = net();

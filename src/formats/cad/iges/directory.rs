@@ -39,13 +39,14 @@ pub struct DirEntry {
 }
 
 impl DirEntry {
-    /// Drawn on its own: visible and not a physical part of another entity (§2.3.1).
+    /// Drawn on its own: not a physical part of another entity (§2.3.1). Blanked
+    /// entities are drawn too, as OpenCASCADE reads them (`read.iges.onlyvisible` is off
+    /// by default): CATIA V4 blanks every surface of some files.
     pub fn is_drawn(&self) -> bool {
-        !self.blank
-            && matches!(
-                self.subordinate,
-                Subordinate::Independent | Subordinate::Logical
-            )
+        matches!(
+            self.subordinate,
+            Subordinate::Independent | Subordinate::Logical
+        )
     }
 }
 

@@ -129,6 +129,12 @@ pub struct Report {
     /// from their model-space curves, which were drawn instead, and the largest distance.
     pub strayed: Vec<usize>,
     pub max_stray: f64,
+    /// Model-space curves (directory sequence numbers) lying far from the surface they
+    /// bound while their parameter-space curves disagree with them: the parameter-space
+    /// curves were drawn.
+    pub off_surface: Vec<usize>,
+    /// Blanked entities (status 01, §2.2.4.4.9) drawn, as OpenCASCADE draws them.
+    pub blanked: usize,
 }
 
 impl Report {
@@ -152,6 +158,18 @@ impl Report {
                 self.projected,
                 self.max_trim_error * self.unit.millimetres,
                 self.max_curve_gap * self.unit.millimetres
+            ));
+        }
+        if self.blanked > 0 {
+            out.push(format!(
+                "IGES blanked entities drawn (as OpenCASCADE reads them): {}",
+                self.blanked
+            ));
+        }
+        if let Some(first) = self.off_surface.first() {
+            out.push(format!(
+                "IGES model-space trim curves lying off their surfaces, their parameter-space curves drawn: {} (first D {first})",
+                self.off_surface.len()
             ));
         }
         if let Some(first) = self.strayed.first() {
@@ -294,6 +312,42 @@ fn tolerated_warning(t: &[Tolerated]) -> Option<String> {
     ))
 }
 
+/// The number of parameter records of `entry`: those from its first that point back to it
+/// (columns 65–72, which every record of the entity carries, §2.2.4.5), where they do;
+/// writers miscount the directory's parameter line count (Rhino 98 writes 20 for a 128
+/// on 7 records), and OpenCASCADE reads an entity to its record delimiter whatever the
+/// count says. A count that disagrees is noted in `miscounted` (directory sequence
+/// number, announced, read). Without back pointers the directory's count stands.
+fn parameter_lines(
+    sections: &records::Sections,
+    entry: &directory::DirEntry,
+    miscounted: &mut Vec<(usize, usize, usize)>,
+) -> usize {
+    let first = entry.param_start.wrapping_sub(1);
+    let owned = sections
+        .owners
+        .get(first..)
+        .unwrap_or(&[])
+        .iter()
+        .take_while(|&&o| o == Some(entry.sequence))
+        .count();
+    if owned == 0 {
+        return entry.param_count.max(1);
+    }
+    if owned != entry.param_count {
+        miscounted.push((entry.sequence, entry.param_count, owned));
+    }
+    owned
+}
+
+fn miscounted_warning(m: &[(usize, usize, usize)]) -> Option<String> {
+    let (sequence, announced, read) = m.first()?;
+    Some(format!(
+        "{} entities whose directory parameter line count disagrees with the records that point back to them, read to their own records (first D {sequence}: {announced} announced, {read} read)",
+        m.len()
+    ))
+}
+
 /// Parses an IGES file. Syntax errors are located parse errors; surfaces that cannot be
 /// converted are reported, not fatal.
 pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
@@ -321,18 +375,22 @@ pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
         max_curve_gap: 0.0,
         strayed: Vec::new(),
         max_stray: 0.0,
+        off_surface: Vec::new(),
+        blanked: 0,
     };
     let entries = directory::entries(path, &sections.directory)?;
     let mut entities = Vec::with_capacity(entries.len());
+    let mut miscounted = Vec::new();
     for entry in &entries {
         if !entities::is_supported(entry.entity_type) {
             entities.push(Entity::Unsupported);
             continue;
         }
         let first = entry.param_start.wrapping_sub(1);
+        let count = parameter_lines(&sections, entry, &mut miscounted);
         let records = sections
             .parameters
-            .get(first..first.saturating_add(entry.param_count.max(1)))
+            .get(first..first.saturating_add(count))
             .ok_or_else(|| {
                 ParseError::new(
                     path,
@@ -377,6 +435,7 @@ pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
         })
     });
     report.warnings.extend(tolerated_warning(&tolerated));
+    report.warnings.extend(miscounted_warning(&miscounted));
     let model = Model {
         entries,
         entities,
@@ -406,6 +465,7 @@ pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
         if !entry.is_drawn() || through_others.contains(&entry.sequence) {
             continue;
         }
+        let before = surfaces.len();
         draw(
             &model,
             entry.sequence,
@@ -414,6 +474,9 @@ pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
             &mut report,
             &mut surfaces,
         );
+        if entry.blank && surfaces.len() > before {
+            report.blanked += 1;
+        }
     }
     Ok(Iges {
         surfaces,

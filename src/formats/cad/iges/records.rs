@@ -26,6 +26,9 @@ pub struct Sections<'a> {
     pub global: Vec<Record<'a>>,
     pub directory: Vec<Record<'a>>,
     pub parameters: Vec<Record<'a>>,
+    /// Per parameter record, the directory entry it belongs to (columns 65–72, §2.2.4.5),
+    /// where written.
+    pub owners: Vec<Option<usize>>,
 }
 
 /// Splits the file into its sections. Lines shorter than 73 columns, an unknown section
@@ -36,6 +39,7 @@ pub fn sections<'a>(path: &Path, src: &'a str) -> Result<Sections<'a>, ParseErro
         global: Vec::new(),
         directory: Vec::new(),
         parameters: Vec::new(),
+        owners: Vec::new(),
     };
     let mut order = 0;
     for (i, raw) in src.lines().enumerate() {
@@ -89,10 +93,16 @@ pub fn sections<'a>(path: &Path, src: &'a str) -> Result<Sections<'a>, ParseErro
         match rank {
             1 => s.global.push(record),
             2 => s.directory.push(record),
-            3 => s.parameters.push(Record {
-                data: data.get(..PARAMETER_COLUMNS).unwrap_or(data),
-                line,
-            }),
+            3 => {
+                s.parameters.push(Record {
+                    data: data.get(..PARAMETER_COLUMNS).unwrap_or(data),
+                    line,
+                });
+                s.owners.push(
+                    data.get(PARAMETER_COLUMNS..)
+                        .and_then(|d| d.trim().parse().ok()),
+                );
+            }
             _ => {}
         }
     }

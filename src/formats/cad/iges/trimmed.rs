@@ -275,21 +275,22 @@ fn with_loops(
     for l in loops {
         let mut parts = Vec::new();
         for e in &l.edges {
-            if let Some(s) =
-                parameter_segments(model, l.model_preferred, e, UvMap::axes(c.to_trim))?
+            let given = parameter_segments(model, l.model_preferred, e, UvMap::axes(c.to_trim))?;
+            let mut off = 0.0;
+            if let Some(s) = &given
+                && e.model != 0
             {
-                let off = if e.model == 0 {
-                    0.0
-                } else {
-                    stray_from_model(model, e, &s, &c)?
-                };
-                if off <= far {
-                    parts.extend(s.into_iter().map(Part::Given));
-                    continue;
-                }
-                stray = stray.max(off);
+                off = stray_from_model(model, e, s, &c)?;
+            }
+            if let Some(s) = &given
+                && off <= far
+            {
+                parts.extend(s.iter().cloned().map(Part::Given));
+                continue;
             }
             let target = target.get_or_insert_with(|| Target::new(&c.surface));
+            let mut projected_parts = Vec::new();
+            let (mut chord, mut gap) = (0.0f64, 0.0f64);
             for piece in edge_pieces(model, e.model, e.reversed)? {
                 let projected = pcurve::project(
                     &*target,
@@ -299,12 +300,27 @@ fn with_loops(
                     target.tolerance,
                 )
                 .map_err(|p| format!("the model-space trim point {p} could not be projected"))?;
-                report.max_trim_error = report.max_trim_error.max(projected.chord);
-                report.max_curve_gap = report.max_curve_gap.max(projected.gap);
+                chord = chord.max(projected.chord);
+                gap = gap.max(projected.gap);
                 if projected.points.len() >= 2 {
-                    parts.push(Part::Projected(projected.points));
+                    projected_parts.push(Part::Projected(projected.points));
                 }
             }
+            // A model-space curve that does not lie on the surface either cannot stand
+            // for a parameter-space curve that disagrees with it: the file's own
+            // preference, the parameter-space curve, is kept (Rhino 98 writes a unit
+            // square 200 mm from the surface it trims), as OpenCASCADE keeps it.
+            if let Some(s) = given
+                && gap > far
+            {
+                report.off_surface.push(model.get(e.model)?.0.sequence);
+                parts.extend(s.into_iter().map(Part::Given));
+                continue;
+            }
+            stray = stray.max(off);
+            report.max_trim_error = report.max_trim_error.max(chord);
+            report.max_curve_gap = report.max_curve_gap.max(gap);
+            parts.extend(projected_parts);
             report.projected += 1;
         }
         let segments = match &target {
