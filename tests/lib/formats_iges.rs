@@ -30,6 +30,8 @@ struct Ent {
     colour: i64,
     /// Status digits 3–4: 0 independent, 1 physically dependent.
     subordinate: u8,
+    /// Status digits 1–2: 01, blanked.
+    blank: bool,
 }
 
 fn ent(ty: i32, params: &[f64]) -> Ent {
@@ -40,6 +42,7 @@ fn ent(ty: i32, params: &[f64]) -> Ent {
         transform: 0,
         colour: 0,
         subordinate: 1,
+        blank: false,
     }
 }
 
@@ -75,7 +78,7 @@ fn write_iges_global(global: &str, ents: &[Ent]) -> String {
             fields: e.params.clone(),
             transform: e.transform,
             colour: e.colour,
-            status: format!("00{:02}0000", e.subordinate),
+            status: format!("{:02}{:02}0000", u8::from(e.blank), e.subordinate),
         })
         .collect();
     fixed_format(global, &entries)
@@ -327,20 +330,9 @@ fn miscounted_parameter_lines_and_blanked_surfaces_read_as_opencascade_reads_the
     // a 128 on 7 records); CATIA V4 blanks every surface of some files. Each parameter
     // record names its entity (columns 65–72), and OpenCASCADE draws blanked entities.
     let n = net();
-    let ents = square_trimmed(&n);
-    let entries: Vec<Entry> = ents
-        .iter()
-        .map(|e| Entry {
-            ty: e.ty,
-            form: e.form,
-            fields: e.params.clone(),
-            transform: e.transform,
-            colour: e.colour,
-            // The 144 blanked (status digits 1–2: 01).
-            status: format!("{:02}{:02}0000", u8::from(e.ty == 144), e.subordinate),
-        })
-        .collect();
-    let text = fixed_format(GLOBAL, &entries);
+    let mut ents = square_trimmed(&n);
+    ents[7].blank = true;
+    let text = write_iges(&ents);
     // The second directory record of each entity: its parameter line count in columns
     // 25–32. The 128's made too large, the first 110's too small.
     let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
