@@ -1,7 +1,8 @@
 //! STEP assembly placements through the real binary. A unit square face in a component is
 //! placed in its assembly by an ITEM_DEFINED_TRANSFORMATION, written both ways CAD systems
-//! write it: the component as `rep_1` (most writers) and the assembly as `rep_1` with the
-//! NEXT_ASSEMBLY_USAGE_OCCURRENCE naming the component (SolidWorks), and as a MAPPED_ITEM.
+//! write it: the component as `rep_1` (most writers), the assembly as `rep_1` with the
+//! NEXT_ASSEMBLY_USAGE_OCCURRENCE naming the component (SolidWorks; CATIA V4 also, but
+//! with the component's frame as `transform_item_1`), and as a MAPPED_ITEM.
 //! Each must put the square where the frame puts it, computed here in closed form.
 
 use crate::common;
@@ -60,10 +61,22 @@ fn product(w: &mut StepWriter, rep: u64, pd_name: &str) -> (u64, u64) {
     (pd, pds)
 }
 
-/// `child` (whose frame is `child_origin`) placed at ORIGIN in an assembly, as most
-/// writers do (component in `rep_1`) or as SolidWorks does (`reversed`); returns the
-/// component's PRODUCT_DEFINITION_SHAPE.
-fn assemble(w: &mut StepWriter, child: u64, child_origin: u64, ctx: u64, reversed: bool) -> u64 {
+/// How a writer lays out a placement's REPRESENTATION_RELATIONSHIP and its
+/// ITEM_DEFINED_TRANSFORMATION.
+#[derive(Clone, Copy, Debug)]
+enum Writing {
+    /// The component as `rep_1`, `transform_item_1` its frame (most writers).
+    ComponentFirst,
+    /// The assembly as `rep_1`, `transform_item_1` the assembly's frame (SolidWorks).
+    AssemblyFirst,
+    /// The assembly as `rep_1`, but `transform_item_1` still the component's frame
+    /// (CATIA V4).
+    AssemblyFirstComponentItemFirst,
+}
+
+/// `child` (whose frame is `child_origin`) placed at ORIGIN in an assembly, written as
+/// `writing` says; returns the component's PRODUCT_DEFINITION_SHAPE.
+fn assemble(w: &mut StepWriter, child: u64, child_origin: u64, ctx: u64, writing: Writing) -> u64 {
     let place = w.axis(ORIGIN, Z, X);
     let parent = w.add(format!("SHAPE_REPRESENTATION('',(#{place}),#{ctx})"));
     let (assembly, _) = product(w, parent, "assembly");
@@ -72,11 +85,10 @@ fn assemble(w: &mut StepWriter, child: u64, child_origin: u64, ctx: u64, reverse
         "NEXT_ASSEMBLY_USAGE_OCCURRENCE('1','','',#{assembly},#{part},$)"
     ));
     let nauo_shape = w.add(format!("PRODUCT_DEFINITION_SHAPE('','',#{nauo})"));
-    // transform_item_1 is an item of rep_1, transform_item_2 of rep_2 (ISO 10303-43).
-    let (rep_1, rep_2, item_1, item_2) = if reversed {
-        (parent, child, place, child_origin)
-    } else {
-        (child, parent, child_origin, place)
+    let (rep_1, rep_2, item_1, item_2) = match writing {
+        Writing::ComponentFirst => (child, parent, child_origin, place),
+        Writing::AssemblyFirst => (parent, child, place, child_origin),
+        Writing::AssemblyFirstComponentItemFirst => (parent, child, child_origin, place),
     };
     let idt = w.add(format!(
         "ITEM_DEFINED_TRANSFORMATION('','',#{item_1},#{item_2})"
@@ -103,11 +115,15 @@ fn aspect(w: &mut StepWriter, pds: u64, rep: u64) {
 }
 
 #[test]
-fn item_defined_transformations_place_the_component_either_way_round() {
-    for reversed in [false, true] {
+fn item_defined_transformations_place_the_component_every_way_round() {
+    for writing in [
+        Writing::ComponentFirst,
+        Writing::AssemblyFirst,
+        Writing::AssemblyFirstComponentItemFirst,
+    ] {
         let (mut w, child, child_origin, ctx, _) = component();
-        assemble(&mut w, child, child_origin, ctx, reversed);
-        check(&w, &format!("reversed_{reversed}.step"));
+        assemble(&mut w, child, child_origin, ctx, writing);
+        check(&w, &format!("{writing:?}.step"));
     }
 }
 
@@ -128,7 +144,7 @@ fn a_shape_aspect_repeating_the_placed_solid_draws_nothing_more() {
     // as one face in the box [10, 20, 30]..[10, 21, 31] (STEPControl_Reader, TransferRoots,
     // TopExp::MapShapes FACE count and BRepBndLib box, run by bench/occ/python.sh).
     let (mut w, child, child_origin, ctx, model) = component();
-    let pds = assemble(&mut w, child, child_origin, ctx, false);
+    let pds = assemble(&mut w, child, child_origin, ctx, Writing::ComponentFirst);
     let aspect_rep = w.add(format!("SHAPE_REPRESENTATION('',(#{model}),#{ctx})"));
     aspect(&mut w, pds, aspect_rep);
     check(&w, "aspect_repeats.step");
@@ -147,7 +163,7 @@ fn a_shape_aspect_holding_geometry_of_its_own_is_part_of_the_product() {
     let (mut w, model, ctx) = square();
     let origin = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
     let main = w.add(format!("SHAPE_REPRESENTATION('',(#{origin}),#{ctx})"));
-    let pds = assemble(&mut w, main, origin, ctx, false);
+    let pds = assemble(&mut w, main, origin, ctx, Writing::ComponentFirst);
     let aspect_rep = w.add(format!("SHAPE_REPRESENTATION('',(#{model}),#{ctx})"));
     aspect(&mut w, pds, aspect_rep);
     check(&w, "aspect_hybrid.step");

@@ -158,24 +158,41 @@ pub fn occurrences(
                 };
                 let item_1 = res.frame(&ir, 2)?.to_affine();
                 let item_2 = res.frame(&ir, 3)?.to_affine();
-                Some(item_2 * item_1.inverse())
+                let ids = (
+                    ir.reference(2, "transform_item_1")?,
+                    ir.reference(3, "transform_item_2")?,
+                );
+                Some((item_2 * item_1.inverse(), ids))
             }
             None => None,
         };
-        // rep_1 → rep_2 as written; reversed when the NAUO says rep_2 is the component.
-        let link = match transform {
-            Some(t) if components.reversed(inst.id, rep_1, rep_2) => Link {
-                child: rep_2,
-                parent: rep_1,
-                transform: Some(t.inverse()),
-            },
-            _ => Link {
-                child: rep_1,
-                parent: rep_2,
-                transform,
-            },
+        // The component is rep_1 as written, rep_2 when the NAUO says so. The placement
+        // takes the component's frame item onto the assembly's: item_2 · item_1⁻¹ when
+        // item_1 is the component's (the usual writing), its inverse when the file puts
+        // item_1 in the assembly (CATIA V4 writes the assembly as rep_1 and item_1 in the
+        // component, which the order of the reps alone would read mirrored). Where
+        // neither item is listed by either representation, the order of the reps decides.
+        let (child, parent) = if components.reversed(inst.id, rep_1, rep_2) {
+            (rep_2, rep_1)
+        } else {
+            (rep_1, rep_2)
         };
-        links.push(link);
+        let transform = transform.map(|(t, (id_1, id_2))| {
+            let lists = |rep: u64, item: u64| lists_item(res, rep, item);
+            let forward = if lists(child, id_1) || lists(parent, id_2) {
+                true
+            } else if lists(child, id_2) || lists(parent, id_1) {
+                false
+            } else {
+                child == rep_1
+            };
+            if forward { t } else { t.inverse() }
+        });
+        links.push(Link {
+            child,
+            parent,
+            transform,
+        });
     }
     for inst in &res.ex.instances {
         let Some(r) = res.named(inst, "MAPPED_ITEM") else {
@@ -337,6 +354,19 @@ const TOPOLOGY: [&str; 10] = [
     "ADVANCED_FACE",
     "FACE_SURFACE",
 ];
+
+/// Whether the representation `rep` lists `item` among its items.
+fn lists_item(res: &Resolver, rep: u64, item: u64) -> bool {
+    res.ex.get(rep).is_some_and(|i| {
+        i.records
+            .iter()
+            .filter(|r| r.name.ends_with("REPRESENTATION"))
+            .any(|r| match r.params.get(1).map(|p| &p.value) {
+                Some(Value::List(items)) => items.iter().any(|p| p.value == Value::Ref(item)),
+                _ => false,
+            })
+    })
+}
 
 fn push_references(params: &[crate::formats::cad::step::records::Param], out: &mut Vec<u64>) {
     for p in params {
