@@ -66,12 +66,12 @@ fn product(w: &mut StepWriter, rep: u64, pd_name: &str) -> (u64, u64) {
 #[derive(Clone, Copy, Debug)]
 enum Writing {
     /// The component as `rep_1`, `transform_item_1` its frame (most writers).
-    ComponentFirst,
+    ComponentRep1,
     /// The assembly as `rep_1`, `transform_item_1` the assembly's frame (SolidWorks).
-    AssemblyFirst,
+    AssemblyRep1,
     /// The assembly as `rep_1`, but `transform_item_1` still the component's frame
     /// (CATIA V4).
-    AssemblyFirstComponentItemFirst,
+    AssemblyRep1ComponentItem1,
 }
 
 /// `child` (whose frame is `child_origin`) placed at ORIGIN in an assembly, written as
@@ -86,9 +86,9 @@ fn assemble(w: &mut StepWriter, child: u64, child_origin: u64, ctx: u64, writing
     ));
     let nauo_shape = w.add(format!("PRODUCT_DEFINITION_SHAPE('','',#{nauo})"));
     let (rep_1, rep_2, item_1, item_2) = match writing {
-        Writing::ComponentFirst => (child, parent, child_origin, place),
-        Writing::AssemblyFirst => (parent, child, place, child_origin),
-        Writing::AssemblyFirstComponentItemFirst => (parent, child, child_origin, place),
+        Writing::ComponentRep1 => (child, parent, child_origin, place),
+        Writing::AssemblyRep1 => (parent, child, place, child_origin),
+        Writing::AssemblyRep1ComponentItem1 => (parent, child, child_origin, place),
     };
     let idt = w.add(format!(
         "ITEM_DEFINED_TRANSFORMATION('','',#{item_1},#{item_2})"
@@ -117,9 +117,9 @@ fn aspect(w: &mut StepWriter, pds: u64, rep: u64) {
 #[test]
 fn item_defined_transformations_place_the_component_every_way_round() {
     for writing in [
-        Writing::ComponentFirst,
-        Writing::AssemblyFirst,
-        Writing::AssemblyFirstComponentItemFirst,
+        Writing::ComponentRep1,
+        Writing::AssemblyRep1,
+        Writing::AssemblyRep1ComponentItem1,
     ] {
         let (mut w, child, child_origin, ctx, _) = component();
         assemble(&mut w, child, child_origin, ctx, writing);
@@ -144,7 +144,7 @@ fn a_shape_aspect_repeating_the_placed_solid_draws_nothing_more() {
     // as one face in the box [10, 20, 30]..[10, 21, 31] (STEPControl_Reader, TransferRoots,
     // TopExp::MapShapes FACE count and BRepBndLib box, run by bench/occ/python.sh).
     let (mut w, child, child_origin, ctx, model) = component();
-    let pds = assemble(&mut w, child, child_origin, ctx, Writing::ComponentFirst);
+    let pds = assemble(&mut w, child, child_origin, ctx, Writing::ComponentRep1);
     let aspect_rep = w.add(format!("SHAPE_REPRESENTATION('',(#{model}),#{ctx})"));
     aspect(&mut w, pds, aspect_rep);
     check(&w, "aspect_repeats.step");
@@ -163,7 +163,7 @@ fn a_shape_aspect_holding_geometry_of_its_own_is_part_of_the_product() {
     let (mut w, model, ctx) = square();
     let origin = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
     let main = w.add(format!("SHAPE_REPRESENTATION('',(#{origin}),#{ctx})"));
-    let pds = assemble(&mut w, main, origin, ctx, Writing::ComponentFirst);
+    let pds = assemble(&mut w, main, origin, ctx, Writing::ComponentRep1);
     let aspect_rep = w.add(format!("SHAPE_REPRESENTATION('',(#{model}),#{ctx})"));
     aspect(&mut w, pds, aspect_rep);
     check(&w, "aspect_hybrid.step");
