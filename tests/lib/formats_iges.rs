@@ -1338,6 +1338,9 @@ fn manifold_solid_b_rep_faces_with_edge_lists_and_loops() {
     let mut lone_face = ents[..9].to_vec();
     lone_face.push(independent(ents[9].clone()));
     assert_eq!(drawn(&lone_face), 1, "a lone 510");
+    // Marked as part of another entity that no shell or solid holds (as OpenCASCADE
+    // writes a lone face): drawn, as OpenCASCADE reads it.
+    assert_eq!(drawn(&ents[..10]), 1, "a lone dependent 510");
     let all_independent: Vec<Ent> = ents.iter().cloned().map(independent).collect();
     assert_eq!(
         drawn(&all_independent),

@@ -462,7 +462,15 @@ pub fn parse_iges(path: &Path, src: &str) -> Result<Iges, ParseError> {
     }
     let mut surfaces = Vec::new();
     for entry in &model.entries {
-        if !entry.is_drawn() || through_others.contains(&entry.sequence) {
+        if through_others.contains(&entry.sequence) {
+            continue;
+        }
+        // A face, shell, solid or trimmed surface marked as part of another entity that no
+        // shell, solid or subfigure holds is drawn on its own, as OpenCASCADE draws every
+        // entity nothing references (OpenCASCADE writes a lone 510 face so).
+        let orphan = matches!(entry.subordinate, directory::Subordinate::Physical)
+            && matches!(entry.entity_type, 143 | 144 | 186 | 510 | 514);
+        if !entry.is_drawn() && !orphan {
             continue;
         }
         let before = surfaces.len();
