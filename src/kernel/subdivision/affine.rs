@@ -140,8 +140,9 @@ impl AffinePatch {
         let denom = self.normal.dot(dir);
         let w = self.origin - orig;
         let t = self.normal.dot(w) / denom;
-        // Also refuses a ray in the plane (0/0) or parallel to it (±∞).
-        if !(f64::from(ray.tmin)..=f64::from(tmax)).contains(&t) {
+        // Refuses a ray in the plane (0/0) or parallel to it (±∞, which an infinite
+        // `tmax` would admit).
+        if !(t.is_finite() && (f64::from(ray.tmin)..=f64::from(tmax)).contains(&t)) {
             return None;
         }
         let p = orig + t * dir;

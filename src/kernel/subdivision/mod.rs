@@ -299,7 +299,8 @@ fn run(
     found.map(KernelHit::Searched)
 }
 
-/// The nearest (the only) hit on an affine patch, which `leaving` says the ray leaves.
+/// The hit on an affine patch (a ray meets it at most once); `leaving` is set when the ray
+/// leaves this patch.
 fn closed_form(
     plane: &AffinePatch,
     trim: Option<&PatchTrim>,

@@ -1,4 +1,4 @@
-use glam::{DMat3, DVec2, DVec3};
+use glam::{DMat3, DVec2, DVec3, Vec3};
 
 use super::*;
 use crate::geom::Ray;
@@ -292,6 +292,17 @@ fn trimmed_planes_honour_their_trim() {
         }
     }
     assert!(through > 150 && on > 500, "{through} through, {on} on");
+}
+
+#[test]
+fn rays_parallel_to_the_plane_miss() {
+    // Exactly parallel: a patch in z = 1 and a ray along x, in the plane (0/0) and
+    // beside it (±∞, which an infinite tmax would admit).
+    let flat = AffinePatch::new(DVec3::new(0.0, 0.0, 1.0), DVec3::X, DVec3::Y).unwrap();
+    for z in [1.0f32, 0.5] {
+        let ray = Ray::new(Vec3::new(-1.0, 0.5, z), Vec3::X);
+        assert!(flat.hit(&as_gray(&ray), f32::INFINITY).is_none(), "z = {z}");
+    }
 }
 
 #[test]
