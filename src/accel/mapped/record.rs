@@ -9,6 +9,7 @@ use crate::geom::bezier::ParamRect;
 use crate::geom::subdiv::Piece;
 use crate::geom::{Aabb, BezierPatch};
 use crate::kernel::subdivision::PreparedPatch;
+use crate::kernel::subdivision::affine::AffinePatch;
 use crate::kernel::subdivision::bicubic::Net;
 use crate::kernel::subdivision::bilinear::BilinearNet;
 use crate::kernel::subdivision::prepared::Prepared;
@@ -22,6 +23,8 @@ const KIND_ROWS: u32 = 0;
 const KIND_COLUMNS: u32 = 1;
 /// `kind` of a bilinear net.
 const KIND_BILINEAR: u32 = 2;
+/// `kind` of an affine patch (closed form, no net: it is made from the corner points).
+const KIND_AFFINE: u32 = 3;
 
 /// `piece_face` of a patch that is not part of a subdivision surface.
 const NO_PIECE: u32 = u32::MAX;
@@ -34,7 +37,7 @@ pub const RECORD_BYTES: usize = size_of::<PatchRecord>();
 #[repr(C)]
 pub(in crate::accel) struct PatchRecord {
     /// The kernel's net: a bicubic [`Net`]'s three blocks of four registers of four lanes,
-    /// or a [`BilinearNet`]'s three registers in the first twelve.
+    /// or a [`BilinearNet`]'s three registers in the first twelve; zero for an affine patch.
     pub(super) net: [f32; 48],
     /// [`PreparedPatch::bounds`]: min xyz, max xyz.
     pub(super) bounds: [f32; 6],
@@ -81,6 +84,7 @@ impl PatchRecord {
                 net.iter_mut().zip(lanes).for_each(|(d, s)| *d = s);
                 KIND_BILINEAR
             }
+            Prepared::Affine(_) => KIND_AFFINE,
             Prepared::General { .. } => return None,
         };
         let b = prepared.bounds();
@@ -128,6 +132,9 @@ impl PatchRecord {
     }
 
     pub(super) fn prepared(&self) -> PreparedPatch {
+        if let Some(affine) = self.affine() {
+            return PreparedPatch::affine(affine);
+        }
         let reg = |at: usize| Vec4::from_slice(&self.net[at..at + 4]);
         let data = match self.kind {
             KIND_BILINEAR => Prepared::Bilinear(BilinearNet {
@@ -142,6 +149,21 @@ impl PatchRecord {
             data,
             bounds: self.bounds(),
         }
+    }
+
+    /// The closed form of an affine record, from the same three corners and by the same
+    /// arithmetic as the patch it was written from ([`AffinePatch::of`]), so the mapped
+    /// patch gives the same hits. `None` for other kinds, and for an affine record whose
+    /// corners are degenerate (only in a file forged past its checksum: [`Self::fault`]
+    /// refuses it).
+    fn affine(&self) -> Option<AffinePatch> {
+        if self.kind != KIND_AFFINE {
+            return None;
+        }
+        let (du, dv) = self.degrees();
+        let point = |k: usize| DVec3::from_slice(&self.points[3 * k..3 * k + 3]);
+        let o = point(0);
+        AffinePatch::new(o, point(du) - o, point(dv * (du + 1)) - o)
     }
 
     /// The `f64` patch. Records are validated when the file is opened (degrees, point count);
@@ -166,8 +188,11 @@ impl PatchRecord {
         if !(1..=3).contains(&du) || !(1..=3).contains(&dv) {
             return Some(format!("degrees {du} × {dv} outside 1..=3"));
         }
-        if self.kind > KIND_BILINEAR {
+        if self.kind > KIND_AFFINE {
             return Some(format!("unknown net kind {}", self.kind));
+        }
+        if self.kind == KIND_AFFINE && self.affine().is_none() {
+            return Some("affine patch with degenerate corners".to_string());
         }
         if self.piece_face != NO_PIECE
             && (self.piece_rot > 3

@@ -10,6 +10,8 @@
 //! - [`ray_space`], [`jump`]: the net transformed into a frame where the ray is the
 //!   z-axis, and Newton jumps there past levels a linearisation already decides.
 //! - [`prepared`]: the per-patch data of the `f32` kernel, built once per patch.
+//! - [`affine`]: no search for affine patches (parallelograms, CAD planes): the ray meets
+//!   the plane once, in closed form.
 //! - [`general`]: any degree up to 15, rational patches (homogeneous nets, §2.7.2).
 //! - [`reference`]: the same algorithm in `f64`, the accuracy reference (§2.3.4).
 //! - [`heuristics`], [`config`], [`param`], [`float`]: split direction, settings,
@@ -21,6 +23,7 @@
 //! bounded by the parameter cell ([`param`]). A coarser [`Termination`] (fixed depth,
 //! adaptive screen-space) can end it earlier, never later.
 
+pub mod affine;
 #[cfg(target_arch = "x86_64")]
 pub mod avx512;
 pub mod bicubic;
@@ -50,6 +53,7 @@ pub use prepared::PreparedPatch;
 pub use ray_space::cull_margin;
 pub use reference::{PatchHit64, intersect_f64};
 
+use affine::{AffineHit, AffinePatch};
 use bicubic::Net;
 use bilinear::BilinearNet;
 use float::{GBox, GRay};
@@ -120,9 +124,12 @@ impl KernelRay {
 
     /// The world box of `hit`'s final box (see [`SpacedHit`]).
     pub fn hit_box(&self, hit: &KernelHit) -> Aabb {
-        match (hit.0.ray_space_scale, &self.frame) {
-            (Some(scale), Some(frame)) => frame.world_box(&hit.0.hit.bbox, scale).to_aabb(),
-            _ => hit.0.hit.bbox.to_aabb(),
+        match hit {
+            KernelHit::Affine(h) => h.hit_box,
+            KernelHit::Searched(h) => match (h.ray_space_scale, &self.frame) {
+                (Some(scale), Some(frame)) => frame.world_box(&h.hit.bbox, scale).to_aabb(),
+                _ => h.hit.bbox.to_aabb(),
+            },
         }
     }
 
@@ -138,20 +145,31 @@ impl KernelRay {
     }
 }
 
-/// A hit of [`nearest`] whose box is still in the space the search ran in: its world box
-/// ([`KernelRay::hit_box`]) is made only for the ray's nearest hit.
+/// A hit of [`nearest`]: a search's, whose box is still in the space the search ran in
+/// (its world box, [`KernelRay::hit_box`], is made only for the ray's nearest hit), or an
+/// affine patch's closed-form crossing.
 #[derive(Clone, Copy, Debug)]
-pub struct KernelHit(SpacedHit);
+pub enum KernelHit {
+    Searched(SpacedHit),
+    Affine(AffineHit),
+}
 
 impl KernelHit {
-    /// The ray parameter at the final box's entry.
+    /// The ray parameter at the final box's entry, or of the closed form's crossing.
     pub fn t(&self) -> f32 {
-        self.0.hit.t
+        match self {
+            KernelHit::Searched(h) => h.hit.t,
+            KernelHit::Affine(h) => h.t,
+        }
     }
 
-    /// The centre of the final parameter cell (Dammertz code 2.3.8).
+    /// The centre of the final parameter cell (Dammertz code 2.3.8), or the closed form's
+    /// (u, v).
     pub fn uv(&self) -> (f64, f64) {
-        self.0.hit.cell.centre()
+        match self {
+            KernelHit::Searched(h) => h.hit.cell.centre(),
+            KernelHit::Affine(h) => (h.u, h.v),
+        }
     }
 }
 
@@ -180,7 +198,7 @@ pub fn nearest(
     leaving: Option<(f64, f64)>,
     stats: &mut KernelStats,
 ) -> Option<KernelHit> {
-    run(patch, trim, ray, tmax, cfg, false, leaving, stats).map(KernelHit)
+    run(patch, trim, ray, tmax, cfg, false, leaving, stats)
 }
 
 /// `hit_box` grown on every side by [`NET_ROUNDING_ULPS`] ulps of the largest coordinate
@@ -226,7 +244,7 @@ fn run(
     any_hit: bool,
     leaving: Option<(f64, f64)>,
     stats: &mut KernelStats,
-) -> Option<SpacedHit> {
+) -> Option<KernelHit> {
     let gray = GRay { tmax, ..ray.ray };
     // On the AVX-512 path the descent around the origin is cheap (ray space, jumps): the
     // triviality test saved about as much as it cost there (BENCHMARKS.md), so only the
@@ -249,7 +267,8 @@ fn run(
         trim,
         trivial,
     };
-    match &patch.data {
+    let found = match &patch.data {
+        Prepared::Affine(plane) => return closed_form(plane, trim, &gray, leaving, stats),
         #[cfg(target_arch = "x86_64")]
         Prepared::Bicubic(net) if avx512::available() => {
             BICUBIC16_SCRATCH.with_borrow_mut(|s| avx512::search_net16(net, s, query, stats))
@@ -276,5 +295,30 @@ fn run(
             )
             .map(SpacedHit::world)
         }),
+    };
+    found.map(KernelHit::Searched)
+}
+
+/// The hit on an affine patch (a ray meets it at most once); `leaving` is set when the ray
+/// leaves this patch.
+fn closed_form(
+    plane: &AffinePatch,
+    trim: Option<&PatchTrim>,
+    ray: &GRay<f32>,
+    leaving: Option<(f64, f64)>,
+    stats: &mut KernelStats,
+) -> Option<KernelHit> {
+    stats.patch_tests += 1;
+    // A line meets a plane once or lies in it: a ray leaving the patch met it at its
+    // origin and cannot meet it again. Exact, so it needs no origin offset; rays from
+    // other surfaces take the closed form.
+    if leaving.is_some() {
+        return None;
     }
+    let hit = plane.hit(ray, ray.tmax)?;
+    let kept = trim.is_none_or(|trim| {
+        stats.trim_tests += 1;
+        trim.keeps(hit.u, hit.v)
+    });
+    kept.then_some(KernelHit::Affine(hit))
 }

@@ -1,6 +1,8 @@
-//! The per-patch data of the `f32` kernel, built once per patch: the bicubic or bilinear
-//! fast path's structure-of-arrays net, or the general path's homogeneous net.
+//! The per-patch data of the `f32` kernel, built once per patch: an affine patch's closed
+//! form, the bicubic or bilinear fast path's structure-of-arrays net, or the general
+//! path's homogeneous net.
 
+use super::affine::AffinePatch;
 use super::bicubic::Net;
 use super::bilinear::BilinearNet;
 use super::general::{NetShape, net_box};
@@ -10,9 +12,14 @@ use crate::geom::{Aabb, BezierPatch};
 /// Which path a patch takes (Dammertz §2.7.1: the choice is made once, before any ray).
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) enum Prepared {
+    /// No search: the ray meets the patch's plane once ([`super::affine`]).
+    Affine(AffinePatch),
     Bicubic(Net),
     Bilinear(BilinearNet),
-    General { net: Vec<[f32; 4]>, shape: NetShape },
+    General {
+        net: Vec<[f32; 4]>,
+        shape: NetShape,
+    },
 }
 
 /// A patch ready for the `f32` subdivision kernel.
@@ -24,6 +31,9 @@ pub struct PreparedPatch {
 
 impl PreparedPatch {
     pub fn new(patch: &BezierPatch) -> PreparedPatch {
+        if let Some(affine) = AffinePatch::of(patch) {
+            return PreparedPatch::affine(affine);
+        }
         if patch.is_plain_bicubic() {
             let net = Net::from_patch(patch);
             return PreparedPatch {
@@ -43,6 +53,14 @@ impl PreparedPatch {
             };
         }
         PreparedPatch::bilinear(patch).unwrap_or_else(|| PreparedPatch::general(patch))
+    }
+
+    /// The closed form of an affine patch.
+    pub(crate) fn affine(affine: AffinePatch) -> PreparedPatch {
+        PreparedPatch {
+            bounds: affine.bounds(),
+            data: Prepared::Affine(affine),
+        }
     }
 
     /// The bilinear fast path, for bilinear integral patches.

@@ -396,7 +396,10 @@ impl<T: KernelFloat> Stop<T> {
 mod tests {
     use glam::{DVec3, Vec3};
 
+    use super::super::bicubic::Net;
     use super::super::config::MAX_SPLITS_PER_TEST;
+    use super::super::prepared::Prepared;
+    use super::super::register::LaneNet;
     use super::super::{PreparedPatch, SubdivisionConfig, intersect};
     use crate::geom::{BezierPatch, Ray};
     use crate::kernel::{KernelStats, PatchHit};
@@ -423,7 +426,13 @@ mod tests {
                 DVec3::new(x, y, plane_z(x, y))
             })
             .collect();
-        PreparedPatch::new(&BezierPatch::from_points(3, 3, &pts).unwrap())
+        // Affine, so `PreparedPatch::new` would take the closed form: this test is about
+        // the search, so the patch is prepared as the bicubic it is.
+        let net = Net::from_patch(&BezierPatch::from_points(3, 3, &pts).unwrap());
+        PreparedPatch {
+            bounds: net.bounds().to_aabb(),
+            data: Prepared::Bicubic(net),
+        }
     }
 
     /// A ray at `angle` (radians) to the plane, from outside the patch, crossing the plane

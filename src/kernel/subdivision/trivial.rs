@@ -102,6 +102,9 @@ impl SmallNet {
     /// at most 3 in each direction).
     fn of(data: &Prepared) -> Option<SmallNet> {
         Some(match data {
+            // A ray leaving a plane never meets it again: the closed form drops the whole
+            // patch before this test.
+            Prepared::Affine(_) => return None,
             Prepared::Bicubic(n) => SmallNet::fill(4, 4, |i, j| Net::point(n, i, j)),
             Prepared::Bilinear(BilinearNet { xyz }) => {
                 SmallNet::fill(2, 2, |i, j| xyz.map(|c| c[i + 2 * j]))
