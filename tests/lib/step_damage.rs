@@ -4,7 +4,8 @@
 //! its reason; an instance that does not parse is skipped and a duplicated instance name
 //! keeps its first definition, each with one located warning. The face left is checked
 //! against its closed form: the plane z = 0 over the unit square. Also the edge curves
-//! OpenCASCADE reads beyond SURFACE_CURVE and LINE: INTERSECTION_CURVE and POLYLINE.
+//! OpenCASCADE reads beyond SURFACE_CURVE and LINE: INTERSECTION_CURVE, POLYLINE and
+//! COMPOSITE_CURVE.
 
 use crate::step_support;
 
@@ -143,10 +144,13 @@ fn with_bad_face(key: &str, damage: impl Fn(&str, u64) -> String) -> (String, u6
     (w.finish(), bad)
 }
 
+/// Damage done to one line of a file, given the line and the id of a Cartesian point.
+type Damage = dyn Fn(&str, u64) -> String;
+
 #[test]
 fn a_malformed_face_costs_that_face_only() {
     let one = real(1.0);
-    let cases: Vec<(&str, &str, Box<dyn Fn(&str, u64) -> String>, String)> = vec![
+    let cases: Vec<(&str, &str, Box<Damage>, String)> = vec![
         (
             "bound to a missing loop",
             "FACE_OUTER_BOUND",
@@ -348,6 +352,33 @@ fn intersection_curve_edges_trim_as_their_3d_curve() {
         w.add(format!(
             "INTERSECTION_CURVE('',#{c},(#{plane},#{plane}),.CURVE_3D.)"
         ))
+    });
+    assert_plane_polygon(&s, &QUAD);
+}
+
+/// COMPOSITE_CURVE edges (ISO 10303-42: segments in order, each along its parent curve or
+/// against it) trim along their segments: the bent side as two segments, the second
+/// written backwards (same_sense false), the others as a lone segment on an unbounded
+/// LINE, which runs between the edge's vertices.
+#[test]
+fn composite_curve_edges_trim_along_their_segments() {
+    let s = quad_with(|w, points, _| {
+        let segments = if points.len() == 3 {
+            let a = polyline(w, &points[..2]);
+            let b = polyline(w, &[points[2], points[1]]);
+            vec![
+                format!("COMPOSITE_CURVE_SEGMENT(.CONTINUOUS.,.T.,#{a})"),
+                format!("COMPOSITE_CURVE_SEGMENT(.CONTINUOUS.,.F.,#{b})"),
+            ]
+        } else {
+            let l = w.line(points[0], points[1] - points[0]);
+            vec![format!("COMPOSITE_CURVE_SEGMENT(.CONTINUOUS.,.T.,#{l})")]
+        };
+        let ids: Vec<String> = segments
+            .into_iter()
+            .map(|s| format!("#{}", w.add(s)))
+            .collect();
+        w.add(format!("COMPOSITE_CURVE('',({}),.F.)", ids.join(",")))
     });
     assert_plane_polygon(&s, &QUAD);
 }
