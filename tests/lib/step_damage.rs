@@ -2,10 +2,10 @@
 //! reference, zero direction or vector, missing parameter, `.U.` for a boolean, a reference
 //! to the wrong type, an instance that does not parse) costs that face only, named with
 //! its reason; an instance that does not parse is skipped and a duplicated instance name
-//! keeps its first definition, each with one located warning. The face left is checked
-//! against its closed form: the plane z = 0 over the unit square. Also the edge curves
-//! OpenCASCADE reads beyond SURFACE_CURVE and LINE: INTERSECTION_CURVE, POLYLINE and
-//! COMPOSITE_CURVE.
+//! keeps its first definition, each with one located warning; a malformed shell costs
+//! what it holds. The face left is checked against its closed form: the plane z = 0 over
+//! the unit square. Also the edge curves OpenCASCADE reads beyond SURFACE_CURVE and LINE:
+//! INTERSECTION_CURVE, POLYLINE and COMPOSITE_CURVE.
 
 use crate::step_support;
 
@@ -227,6 +227,31 @@ fn a_malformed_face_costs_that_face_only() {
             .collect();
         assert_eq!(named.len(), 1, "{what}: {warnings:?}");
     }
+}
+
+/// A shell whose face list is malformed is lost with what it holds, named (as the
+/// representation item it was reached from) with its located reason; the other items
+/// are read.
+#[test]
+fn a_malformed_shell_costs_its_item_only() {
+    let mut w = StepWriter::default();
+    good_face(&mut w);
+    let shell = w.add("OPEN_SHELL('',#999999)");
+    let model = w.add(format!("SHELL_BASED_SURFACE_MODEL('',(#{shell}))"));
+    w.items.push(model);
+    let m = read(&w.finish());
+    let s = surfaces(&m);
+    assert_eq!(s.len(), 1);
+    assert_plane_polygon(&s[0], &UNIT_SQUARE);
+    let failed = &m.report.failed_faces;
+    assert_eq!(failed.len(), 1, "{failed:?}");
+    assert_eq!(failed[0].0, model);
+    assert!(
+        failed[0].1.contains(&format!(
+            "#{shell} OPEN_SHELL: expected a list of items, found a reference"
+        )),
+        "{failed:?}"
+    );
 }
 
 /// Where nothing renderable is left, the file is still refused, saying why each face
