@@ -35,6 +35,7 @@ mod robust_mesh_files;
 mod robust_parsers;
 mod stability_suite;
 mod step_assembly;
+mod step_damage;
 mod step_entities;
 mod step_faces;
 mod step_part;

@@ -137,6 +137,36 @@ impl<'a> Lexer<'a> {
         }
     }
 
+    /// Skips the rest of a malformed instance: everything through the next `;` outside
+    /// strings, binaries and comments (a `;` inside them ends nothing). A string, binary or
+    /// comment left open, or the end of the input before any `;`, is an error.
+    pub fn skip_past_semicolon(&mut self) -> Result<(), LexError> {
+        let bytes = self.src.as_bytes();
+        loop {
+            self.skip_space()?;
+            let start = self.pos;
+            match bytes.get(start) {
+                None => {
+                    return Err(
+                        self.error(start, "expected `;` ending the instance, found end of file")
+                    );
+                }
+                Some(b';') => {
+                    self.pos += 1;
+                    return Ok(());
+                }
+                Some(b'\'') => self.pos = self.string(start)?.1,
+                Some(b'"') => {
+                    self.pos = self.binary_end(start)?;
+                    self.bump_newlines(start, self.pos);
+                }
+                // Byte by byte: a multi-byte character's bytes are all above 127, so the
+                // scan never stops inside one.
+                Some(_) => self.pos += 1,
+            }
+        }
+    }
+
     /// The next token, `None` at end of input.
     pub fn next_token(&mut self) -> Result<Option<Token<'a>>, LexError> {
         self.skip_space()?;
@@ -164,11 +194,8 @@ impl<'a> Lexer<'a> {
             }
             b'\'' => self.string(start)?,
             b'"' => {
-                let Some(len) = self.src[start + 1..].find('"') else {
-                    return Err(self.error(start, "binary `\"` is never closed"));
-                };
-                let end = start + 1 + len;
-                (TokenKind::Binary(&self.src[start + 1..end]), end + 1)
+                let end = self.binary_end(start)?;
+                (TokenKind::Binary(&self.src[start + 1..end - 1]), end)
             }
             b'.' if bytes.get(start + 1).is_some_and(u8::is_ascii_alphabetic) => {
                 let end = word_end(bytes, start + 1);
@@ -189,6 +216,14 @@ impl<'a> Lexer<'a> {
         };
         self.pos = end;
         Ok(Some(Token { kind, line, column }))
+    }
+
+    /// The end of the binary opened by the `"` at `start`, past its closing `"`.
+    fn binary_end(&self, start: usize) -> Result<usize, LexError> {
+        match self.src[start + 1..].find('"') {
+            Some(len) => Ok(start + 1 + len + 1),
+            None => Err(self.error(start, "binary `\"` is never closed")),
+        }
     }
 
     /// A number per Part 21 §6.3.2/6.3.3: sign, digits, then `.` and an optional exponent

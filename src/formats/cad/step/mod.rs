@@ -11,9 +11,13 @@
 //!   rectangular-trimmed, bare), and `tessellated` items as triangles.
 //! - `assembly`, `units`, `style`: placements of parts, length units, colours.
 //!
-//! Malformed files (syntax, wrong parameter kinds, dangling references) are errors located
-//! at `file.step:LINE:COL: #id ENTITY: …`. Entities that are valid but that the reader does
-//! not convert are counted by type, and faces that cannot be converted are named by `#id`;
+//! As in OpenCASCADE's reader, damage costs only what it touches: an instance that does
+//! not parse is skipped (one warning), and a face (or standalone surface, tessellated
+//! item) that is malformed (wrong parameter kinds, dangling references, zero directions)
+//! or uses what the reader does not convert is named by `#id` with its reason, located at
+//! `LINE:COL: #id ENTITY: …`; entities the reader does not convert are counted by type.
+//! A file whose structure is broken (header, sections, a string left open) is an error
+//! located the same way;
 //! the [CAD front door](crate::formats::cad::scene) turns what was read into the scene, the
 //! lines `info` prints and one warning line.
 
@@ -291,11 +295,17 @@ pub fn read_model(path: &Path, src: &str) -> Result<(CadModel, Report), ParseErr
     for occ in &occurrences {
         let mut leaves = Vec::new();
         for &item in &occ.items {
-            items::leaves(&res, item, &colours, &mut unsupported, &mut leaves)?;
+            // A container that cannot be walked (a shell with a malformed face list) is
+            // lost with what it holds; the leaves found before the error are kept.
+            if let Err(e) = items::leaves(&res, item, &colours, &mut unsupported, &mut leaves)
+                && !report.failed_faces.iter().any(|&(f, _)| f == item)
+            {
+                report.failed_faces.push((item, why(&e)));
+            }
         }
         for &(id, _) in &leaves {
             if seen.insert(id)
-                && let Some(source) = resolve(&res, id, &mut report, &mut unsupported)?
+                && let Some(source) = resolve(&res, id, &mut report, &mut unsupported)
             {
                 resolved.push((id, source));
             }
@@ -476,35 +486,43 @@ fn convert(source: Source, size: f64) -> Result<Converted, String> {
     })
 }
 
-/// The entities of leaf `id`; a leaf that is valid STEP but uses what the reader does not
-/// convert is recorded in the report and gives `None`, a malformed one is an error.
+/// Why an entity could not be read, for the failure list: the error's line and column in
+/// the file and its message (which names the malformed instance).
+fn why(e: &ParseError) -> String {
+    format!("{}:{}: {}", e.line, e.column, e.message)
+}
+
+/// The entities of leaf `id`, or `None` with the reason recorded in the report: a leaf
+/// that is valid STEP but uses what the reader does not convert, or a malformed one (a
+/// dangling reference, a zero direction, a parameter missing or of the wrong kind). As
+/// with OpenCASCADE, one bad face costs that face, not the file.
 fn resolve(
     res: &Resolver,
     id: u64,
     report: &mut Report,
     unsupported: &mut BTreeMap<String, usize>,
-) -> Result<Option<Source>, ParseError> {
-    let Some(inst) = res.ex.get(id) else {
-        return Ok(None);
-    };
+) -> Option<Source> {
+    let inst = res.ex.get(id)?;
     res.take_unsupported();
     let read = match items::kind(inst) {
         items::Kind::Face => res.face(inst).map(Source::Face),
         items::Kind::Surface => surfaces::read(res, inst).map(Source::Standalone),
         items::Kind::Tessellated => tessellated::read(res, inst).map(Source::Mesh),
-        _ => return Ok(None),
+        _ => return None,
     };
     match read {
-        Ok(s) => Ok(Some(s)),
-        Err(e) => match res.take_unsupported() {
-            Some(kind) => {
-                *unsupported.entry(kind.clone()).or_default() += 1;
-                report
-                    .failed_faces
-                    .push((id, format!("uses {kind}, which is not supported")));
-                Ok(None)
-            }
-            None => Err(e),
-        },
+        Ok(s) => Some(s),
+        Err(e) => {
+            let reason = match res.take_unsupported() {
+                Some(kind) => {
+                    let reason = format!("uses {kind}, which is not supported");
+                    *unsupported.entry(kind).or_default() += 1;
+                    reason
+                }
+                None => why(&e),
+            };
+            report.failed_faces.push((id, reason));
+            None
+        }
     }
 }

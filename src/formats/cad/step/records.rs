@@ -148,12 +148,33 @@ const MAX_NESTING: usize = 64;
 struct Parser<'a> {
     lexer: Lexer<'a>,
     peeked: Option<Token<'a>>,
+    /// Whether the last token read was a `;` (so a malformed instance that it ended needs
+    /// no skipping).
+    ended: bool,
+}
+
+/// Instances of the DATA section left out, for the one warning that reports them.
+#[derive(Default)]
+struct Dropped {
+    count: usize,
+    /// The first one's instance name (when it got that far) and error.
+    first: Option<(Option<u64>, LexError)>,
+}
+
+impl Dropped {
+    fn push(&mut self, id: Option<u64>, e: LexError) {
+        self.count += 1;
+        self.first.get_or_insert((id, e));
+    }
 }
 
 impl<'a> Parser<'a> {
     fn peek(&mut self) -> Result<Option<&Token<'a>>, LexError> {
         if self.peeked.is_none() {
-            self.peeked = self.lexer.next_token()?;
+            self.peeked = self
+                .lexer
+                .next_token()
+                .inspect_err(|_| self.ended = false)?;
         }
         Ok(self.peeked.as_ref())
     }
@@ -161,7 +182,10 @@ impl<'a> Parser<'a> {
     fn next(&mut self, what: &str) -> Result<Token<'a>, LexError> {
         self.peek()?;
         match self.peeked.take() {
-            Some(t) => Ok(t),
+            Some(t) => {
+                self.ended = t.kind == TokenKind::Semicolon;
+                Ok(t)
+            }
             None => {
                 let (line, column) = self.lexer.here();
                 Err(LexError {
@@ -281,58 +305,90 @@ impl<'a> Parser<'a> {
         }
     }
 
-    /// `#id = …;` instances up to `ENDSEC;`, appended to `ex`.
-    fn data(&mut self, ex: &mut Exchange<'a>) -> Result<(), LexError> {
+    /// `#id = …;` instances up to `ENDSEC;`, appended to `ex`. An instance that does not
+    /// parse is skipped through the `;` that ends it, and a second definition of an
+    /// instance name is ignored, as OpenCASCADE's reader does: the error is then the
+    /// entities' that reference them, not the whole file's. A section that never ends
+    /// (a string left open, no `ENDSEC;`) is an error.
+    fn data(
+        &mut self,
+        ex: &mut Exchange<'a>,
+        malformed: &mut Dropped,
+        duplicates: &mut Dropped,
+    ) -> Result<(), LexError> {
         loop {
-            let t = self.next("an instance `#id = …;` or `ENDSEC`")?;
-            let id = match t.kind {
-                TokenKind::Keyword("ENDSEC") => {
-                    self.expect(TokenKind::Semicolon, "`;` after `ENDSEC`")?;
-                    return Ok(());
-                }
-                TokenKind::Instance(id) => id,
-                _ => return Err(Self::unexpected(&t, "an instance `#id = …;` or `ENDSEC`")),
-            };
-            self.expect(TokenKind::Equals, &format!("`=` after `#{id}`"))?;
-            let first = self.next("an entity name or `(`")?;
-            let (records, complex) = match first.kind {
-                TokenKind::Keyword(name) => {
-                    (vec![self.record(name, first.line, first.column)?], false)
-                }
-                TokenKind::Open => {
-                    let mut records = Vec::new();
-                    loop {
-                        let r = self.next("a partial entity name or `)`")?;
-                        match r.kind {
-                            TokenKind::Keyword(name) => {
-                                records.push(self.record(name, r.line, r.column)?)
-                            }
-                            TokenKind::Close if !records.is_empty() => break,
-                            _ => {
-                                return Err(Self::unexpected(&r, "a partial entity name or `)`"));
-                            }
-                        }
-                    }
-                    (records, true)
-                }
-                _ => return Err(Self::unexpected(&first, "an entity name or `(`")),
-            };
-            self.expect(TokenKind::Semicolon, "`;` ending the instance")?;
-            if ex.index.insert(id, ex.instances.len()).is_some() {
-                return Err(LexError {
-                    line: t.line,
-                    column: t.column,
-                    message: format!("instance #{id} is defined twice"),
-                });
+            if matches!(self.peek(), Ok(Some(t)) if t.kind == TokenKind::Keyword("ENDSEC")) {
+                self.peeked = None;
+                self.expect(TokenKind::Semicolon, "`;` after `ENDSEC`")?;
+                return Ok(());
             }
-            ex.instances.push(Instance {
-                id,
-                records,
-                complex,
-                line: t.line,
-                column: t.column,
-            });
+            let mut id = None;
+            match self.instance(&mut id) {
+                Ok(inst) if ex.index.contains_key(&inst.id) => duplicates.push(
+                    Some(inst.id),
+                    LexError {
+                        line: inst.line,
+                        column: inst.column,
+                        message: format!("#{} is defined again", inst.id),
+                    },
+                ),
+                Ok(inst) => {
+                    ex.index.insert(inst.id, ex.instances.len());
+                    ex.instances.push(inst);
+                }
+                Err(e) => {
+                    if self
+                        .peeked
+                        .take()
+                        .is_some_and(|t| t.kind == TokenKind::Semicolon)
+                        || self.ended
+                    {
+                        self.ended = false;
+                    } else if self.lexer.skip_past_semicolon().is_err() {
+                        // Nothing ends it: the file is cut or a string runs to its end.
+                        return Err(e);
+                    }
+                    malformed.push(id, e);
+                }
+            }
         }
+    }
+
+    /// One instance `#id = NAME(…);` or `#id = (A(…) B(…));`; `id` is set once read.
+    fn instance(&mut self, id: &mut Option<u64>) -> Result<Instance<'a>, LexError> {
+        let t = self.next("an instance `#id = …;` or `ENDSEC`")?;
+        let TokenKind::Instance(n) = t.kind else {
+            return Err(Self::unexpected(&t, "an instance `#id = …;` or `ENDSEC`"));
+        };
+        *id = Some(n);
+        self.expect(TokenKind::Equals, &format!("`=` after `#{n}`"))?;
+        let first = self.next("an entity name or `(`")?;
+        let (records, complex) = match first.kind {
+            TokenKind::Keyword(name) => (vec![self.record(name, first.line, first.column)?], false),
+            TokenKind::Open => {
+                let mut records = Vec::new();
+                loop {
+                    let r = self.next("a partial entity name or `)`")?;
+                    match r.kind {
+                        TokenKind::Keyword(name) => {
+                            records.push(self.record(name, r.line, r.column)?)
+                        }
+                        TokenKind::Close if !records.is_empty() => break,
+                        _ => return Err(Self::unexpected(&r, "a partial entity name or `)`")),
+                    }
+                }
+                (records, true)
+            }
+            _ => return Err(Self::unexpected(&first, "an entity name or `(`")),
+        };
+        self.expect(TokenKind::Semicolon, "`;` ending the instance")?;
+        Ok(Instance {
+            id: n,
+            records,
+            complex,
+            line: t.line,
+            column: t.column,
+        })
     }
 }
 
@@ -342,7 +398,9 @@ pub fn parse(src: &str) -> Result<Exchange<'_>, LexError> {
     let mut p = Parser {
         lexer: Lexer::new(src),
         peeked: None,
+        ended: false,
     };
+    let (mut malformed, mut duplicates) = (Dropped::default(), Dropped::default());
     p.keyword("ISO-10303-21")?;
     p.expect(TokenKind::Semicolon, "`;` after `ISO-10303-21`")?;
     p.keyword("HEADER")?;
@@ -361,10 +419,23 @@ pub fn parse(src: &str) -> Result<Exchange<'_>, LexError> {
                     p.list_tail(0)?;
                 }
                 p.expect(TokenKind::Semicolon, "`;` after `DATA`")?;
-                p.data(&mut ex)?;
+                p.data(&mut ex, &mut malformed, &mut duplicates)?;
             }
             TokenKind::Keyword("END-ISO-10303-21") => {
                 p.expect(TokenKind::Semicolon, "`;` after `END-ISO-10303-21`")?;
+                if let Some((id, e)) = &malformed.first {
+                    let name = id.map(|id| format!("#{id}: ")).unwrap_or_default();
+                    ex.warnings.push(format!(
+                        "{}:{}: {} instance(s) of the DATA section do not parse and were skipped through their `;` (first {name}{})",
+                        e.line, e.column, malformed.count, e.message
+                    ));
+                }
+                if let Some((_, e)) = &duplicates.first {
+                    ex.warnings.push(format!(
+                        "{}:{}: {} instance name(s) defined more than once; the first definition of each is kept (first: {})",
+                        e.line, e.column, duplicates.count, e.message
+                    ));
+                }
                 if let Some((line, column, text)) = &p.lexer.first_literal {
                     ex.warnings.push(format!(
                         "{line}:{column}: {} backslash(es) in strings begin no escape of ISO 10303-21 §6.4.3 (first `{text}`, as in a Windows path) and were kept as text",
@@ -411,22 +482,65 @@ mod tests {
         assert_eq!((m.line, m.column), (10, 35));
     }
 
+    /// As OpenCASCADE reads them: an instance that does not parse is skipped through its
+    /// `;` (one inside a string or a comment ends nothing), a name defined twice keeps its
+    /// first definition, each with one located warning; the rest of the file is read.
     #[test]
-    fn located_syntax_errors() {
-        let bad = FILE.replace("#3=", "#2=");
-        let e = parse(&bad).unwrap_err();
-        assert_eq!(
-            (e.line, e.message.as_str()),
-            (10, "instance #2 is defined twice")
-        );
+    fn malformed_instances_are_skipped_and_duplicates_keep_the_first() {
         let bad = FILE.replace("(0.,1.,2.)", "(0.,1. 2.)");
-        let e = parse(&bad).unwrap_err();
-        assert_eq!((e.line, e.column), (7, 30));
-        assert_eq!(e.message, "expected `,` or `)`, found `2`");
-        let e = parse(&FILE[..FILE.len() - 26]).unwrap_err();
-        assert!(e.message.contains("end of file"), "{}", e.message);
+        let ex = parse(&bad).unwrap();
+        assert!(ex.get(2).is_none());
+        assert_eq!(ex.instances.len(), 2);
+        assert_eq!(
+            ex.warnings,
+            vec![
+                "7:30: 1 instance(s) of the DATA section do not parse and were skipped through their `;` (first #2: expected `,` or `)`, found `2`)"
+            ]
+        );
+        // The skip looks past `;` in strings and comments, and a `;` that is itself the
+        // unexpected token ends the instance.
+        let bad = FILE.replace(
+            "#2=CARTESIAN_POINT('',(0.,1.,2.));",
+            "#2=CARTESIAN_POINT('a;b' /* ; */ 5 'c;');\n#4=CARTESIAN_POINT('',(0.,1.;\n#5=A();",
+        );
+        let ex = parse(&bad).unwrap();
+        assert_eq!(
+            ex.instances.iter().map(|i| i.id).collect::<Vec<_>>(),
+            vec![5, 1, 3]
+        );
+        assert!(
+            ex.warnings[0].contains(" 2 instance(s) "),
+            "{:?}",
+            ex.warnings
+        );
+        let twice = FILE.replace("#3=", "#2=");
+        let ex = parse(&twice).unwrap();
+        assert_eq!(ex.instances.len(), 2);
+        assert_eq!(ex.get(2).unwrap().records[0].name, "CARTESIAN_POINT");
+        assert_eq!(
+            ex.warnings,
+            vec![
+                "10:1: 1 instance name(s) defined more than once; the first definition of each is kept (first: #2 is defined again)"
+            ]
+        );
         let deep = format!("{}{}", "(".repeat(100), ")".repeat(100));
         let bad = FILE.replace("(0.,1.,2.)", &deep);
-        assert!(parse(&bad).unwrap_err().message.contains("nest deeper"));
+        let ex = parse(&bad).unwrap();
+        assert!(ex.warnings[0].contains("nest deeper"), "{:?}", ex.warnings);
+    }
+
+    /// What breaks the file's structure stays a located error: a cut file, a string left
+    /// open to the end, a header that does not parse.
+    #[test]
+    fn broken_structure_is_a_located_error() {
+        let e = parse(&FILE[..FILE.len() - 26]).unwrap_err();
+        assert!(e.message.contains("end of file"), "{}", e.message);
+        let e = parse(&FILE.replace("(0.,1.,2.));", "(0.,'1.,2.));")).unwrap_err();
+        assert_eq!((e.line, e.column), (7, 27));
+        assert!(e.message.contains("never closed"), "{}", e.message);
+        let e = parse(&FILE.replace("'2;1');", "'2;1';")).unwrap_err();
+        assert_eq!((e.line, e.column), (3, 28));
+        let e = parse(&FILE.replace("DATA;", "")).unwrap_err();
+        assert!(e.message.contains("`DATA`"), "{}", e.message);
     }
 }

@@ -13,9 +13,7 @@
 
 use std::sync::Arc;
 
-use glam::DVec3;
-
-use super::entities::{Bound, Edge, Face, OrientedEdge, Rec, Resolver, SurfaceDef};
+use super::entities::{Bound, Face, Rec, Resolver, SurfaceDef};
 use super::geometry::surface_to_nurbs;
 use super::records::Instance;
 use crate::formats::error::ParseError;
@@ -185,16 +183,7 @@ fn curve_bounded(res: &Resolver, r: &Rec) -> Result<Face, ParseError> {
 fn boundary(res: &Resolver, b: &Rec) -> Result<Bound, ParseError> {
     let mut edges = Vec::new();
     for id in b.references(1, "composite curve segments")? {
-        let s = res.expect_type(
-            b,
-            id,
-            &[
-                "COMPOSITE_CURVE_SEGMENT",
-                "REPARAMETRISED_COMPOSITE_CURVE_SEGMENT",
-            ],
-            1,
-        )?;
-        edges.push(res.deeper(&s, || segment(res, &s))?);
+        edges.push(res.segment(b, id, None)?);
     }
     if edges.is_empty() {
         return Err(b.error("expected at least one segment"));
@@ -205,32 +194,5 @@ fn boundary(res: &Resolver, b: &Rec) -> Result<Bound, ParseError> {
         orientation: true,
         edges,
         vertex: None,
-    })
-}
-
-/// COMPOSITE_CURVE_SEGMENT(transition, same_sense, parent_curve) as an edge from the
-/// parent's start to its end, traversed along it when `same_sense`.
-fn segment(res: &Resolver, s: &Rec) -> Result<OrientedEdge, ParseError> {
-    let same_sense = s.boolean(1, "same_sense")?;
-    let curve = res.curve(s, 2)?;
-    let (t0, t1) = curve.space_curve().domain();
-    if !(t0.is_finite() && t1.is_finite() && t0 < t1) {
-        return Err(s.error("expected a bounded parent curve"));
-    }
-    let (start, end): (DVec3, DVec3) = (curve.point(t0), curve.point(t1));
-    // A parent that closes on itself (a whole circle, a closed B-spline) is one edge
-    // around it, as an edge on a single vertex is (ends equal within rounding, as
-    // `Curve::closed_period` takes them).
-    let closed = start.distance(end) <= 1e-9 * (1.0 + start.abs().max_element());
-    Ok(OrientedEdge {
-        orientation: same_sense,
-        edge: Arc::new(Edge {
-            id: s.inst.id,
-            start,
-            end,
-            closed,
-            curve,
-            same_sense: true,
-        }),
     })
 }

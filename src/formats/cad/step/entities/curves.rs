@@ -32,8 +32,8 @@ pub enum Curve {
         t1: f64,
         sense: bool,
     },
-    /// SURFACE_CURVE / SEAM_CURVE: the 3D curve and its pcurves (a seam has two on the
-    /// same surface).
+    /// A curve on surfaces ([`ON_SURFACE`]: SURFACE_CURVE, SEAM_CURVE, INTERSECTION_CURVE…):
+    /// the 3D curve and its pcurves (a seam has two on the same surface).
     OnSurface {
         curve: Arc<Curve>,
         pcurves: Vec<PCurve>,
@@ -47,6 +47,16 @@ pub struct PCurve {
     pub surface: u64,
     pub curve: Arc<Curve>,
 }
+
+/// The curves on surfaces (ISO 10303-42: surface_curve and its subtypes seam_curve,
+/// bounded_surface_curve and intersection_curve, all with the attributes curve_3d,
+/// associated_geometry and master_representation).
+const ON_SURFACE: [&str; 4] = [
+    "SURFACE_CURVE",
+    "SEAM_CURVE",
+    "BOUNDED_SURFACE_CURVE",
+    "INTERSECTION_CURVE",
+];
 
 impl<'e, 'a> Resolver<'e, 'a> {
     /// Any supported curve (3D or, in a pcurve, 2D).
@@ -71,7 +81,7 @@ impl<'e, 'a> Resolver<'e, 'a> {
         // A complex instance (BOUNDED_CURVE() CURVE() … SURFACE_CURVE(…), as Alias and
         // AutoCAD write the curves bounding a CURVE_BOUNDED_SURFACE) is read by the record
         // that defines its curve.
-        let r = ["SURFACE_CURVE", "SEAM_CURVE", "BOUNDED_SURFACE_CURVE"]
+        let r = ON_SURFACE
             .iter()
             .find_map(|n| self.named(inst, n))
             .unwrap_or_else(|| self.rec(inst));
@@ -96,7 +106,8 @@ impl<'e, 'a> Resolver<'e, 'a> {
                 b: r.positive(3, "semi_axis_2")?,
             }),
             "TRIMMED_CURVE" => self.trimmed_curve(&r),
-            "SURFACE_CURVE" | "SEAM_CURVE" | "BOUNDED_SURFACE_CURVE" => {
+            "POLYLINE" => self.polyline(&r).map(Curve::BSpline),
+            "SURFACE_CURVE" | "SEAM_CURVE" | "BOUNDED_SURFACE_CURVE" | "INTERSECTION_CURVE" => {
                 // (name, curve_3d, associated_geometry, master_representation); in a
                 // complex instance the name belongs to REPRESENTATION_ITEM's record.
                 let off = usize::from(!inst.complex);
@@ -117,8 +128,35 @@ impl<'e, 'a> Resolver<'e, 'a> {
                 }
                 Ok(Curve::OnSurface { curve, pcurves })
             }
-            _ => Err(self.unsupported(&r, "a supported curve (LINE, CIRCLE, ELLIPSE, B_SPLINE_CURVE_WITH_KNOTS, BEZIER_CURVE, UNIFORM_CURVE, QUASI_UNIFORM_CURVE, TRIMMED_CURVE, SURFACE_CURVE, SEAM_CURVE)")),
+            _ => Err(self.unsupported(&r, "a supported curve (LINE, CIRCLE, ELLIPSE, POLYLINE, B_SPLINE_CURVE_WITH_KNOTS, BEZIER_CURVE, UNIFORM_CURVE, QUASI_UNIFORM_CURVE, TRIMMED_CURVE, SURFACE_CURVE, SEAM_CURVE, INTERSECTION_CURVE)")),
         }
+    }
+
+    /// POLYLINE(name, points): ISO 10303-42 puts segment i (from 1) between points i and
+    /// i + 1 at parameters i - 1 ..= i, which is exactly the degree-1 B-spline on those
+    /// points with knots 0, 0, 1, …, n - 2, n - 1, n - 1.
+    fn polyline(&self, r: &Rec) -> Result<NurbsCurve, ParseError> {
+        let ids = r.references(1, "points")?;
+        if ids.len() < 2 {
+            return Err(r.error(format!("expected at least 2 points, found {}", ids.len())));
+        }
+        let points = ids
+            .iter()
+            .map(|&id| {
+                let p = self.expect_type(r, id, &["CARTESIAN_POINT"], 1)?;
+                self.coordinates(&p, 1, "coordinates")
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let last = (points.len() - 1) as f64;
+        let knots = std::iter::once(0.0)
+            .chain((0..points.len()).map(|k| k as f64))
+            .chain(std::iter::once(last))
+            .collect();
+        Ok(NurbsCurve {
+            degree: 1,
+            knots,
+            points: homogeneous(&points, &vec![1.0; points.len()]),
+        })
     }
 
     fn pcurve(&self, inst: &'e Instance<'a>) -> Result<PCurve, ParseError> {

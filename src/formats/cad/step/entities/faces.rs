@@ -124,8 +124,13 @@ impl<'e, 'a> Resolver<'e, 'a> {
                 let oe = self.expect_type(&l, id, &["ORIENTED_EDGE"], 1)?;
                 let orientation = oe.boolean(4, "orientation")?;
                 let eid = oe.reference(3, "an EDGE_CURVE")?;
-                let edge = self.deeper(&oe, || self.edge(&oe, eid))?;
-                edges.push(OrientedEdge { orientation, edge });
+                match self.deeper(&oe, || self.composite_edge(&oe, eid, orientation))? {
+                    Some(pieces) => edges.extend(pieces),
+                    None => {
+                        let edge = self.deeper(&oe, || self.edge(&oe, eid))?;
+                        edges.push(OrientedEdge { orientation, edge });
+                    }
+                }
             }
         }
         Ok(Bound {
@@ -140,6 +145,97 @@ impl<'e, 'a> Resolver<'e, 'a> {
     fn vertex(&self, from: &Rec, i: usize) -> Result<DVec3, ParseError> {
         let v = self.follow(from, i, &["VERTEX_POINT"])?;
         self.point(&v, 1)
+    }
+
+    /// An EDGE_CURVE on a COMPOSITE_CURVE(name, segments, self_intersect) as one edge per
+    /// segment, in the order the loop runs them (`None` for an edge on any other curve), as
+    /// OpenCASCADE's StepToTopoDS_TranslateEdge splits it into a wire. The composite runs
+    /// from the edge's start vertex to its end when the edge's same_sense is true; a lone
+    /// segment on an unbounded parent (a LINE) runs between the vertices.
+    fn composite_edge(
+        &self,
+        from: &Rec,
+        id: u64,
+        orientation: bool,
+    ) -> Result<Option<Vec<OrientedEdge>>, ParseError> {
+        let e = self.expect_type(from, id, &["EDGE_CURVE"], 3)?;
+        let curve = self.instance(&e, e.reference(3, "a curve")?)?;
+        if curve.records[0].name != "COMPOSITE_CURVE" {
+            return Ok(None);
+        }
+        let c = self.rec(curve);
+        let same_sense = e.boolean(4, "same_sense")?;
+        let (start, end) = (self.vertex(&e, 1)?, self.vertex(&e, 2)?);
+        let ends = if same_sense {
+            (start, end)
+        } else {
+            (end, start)
+        };
+        let ids = c.references(1, "composite curve segments")?;
+        if ids.is_empty() {
+            return Err(c.error("expected at least one segment"));
+        }
+        let lone = (ids.len() == 1).then_some(ends);
+        let mut pieces = ids
+            .iter()
+            .map(|&s| self.segment(&c, s, lone))
+            .collect::<Result<Vec<_>, _>>()?;
+        if orientation != same_sense {
+            pieces.reverse();
+            for p in &mut pieces {
+                p.orientation = !p.orientation;
+            }
+        }
+        Ok(Some(pieces))
+    }
+
+    /// COMPOSITE_CURVE_SEGMENT(transition, same_sense, parent_curve) `id`, referenced from
+    /// `from`, as an edge from the parent's start to its end, traversed along it when
+    /// `same_sense`. An unbounded parent takes the composite's `ends` (its start and end
+    /// points in its own direction) when given.
+    pub fn segment(
+        &self,
+        from: &Rec,
+        id: u64,
+        ends: Option<(DVec3, DVec3)>,
+    ) -> Result<OrientedEdge, ParseError> {
+        let s = self.expect_type(
+            from,
+            id,
+            &[
+                "COMPOSITE_CURVE_SEGMENT",
+                "REPARAMETRISED_COMPOSITE_CURVE_SEGMENT",
+            ],
+            1,
+        )?;
+        self.deeper(&s, || {
+            let same_sense = s.boolean(1, "same_sense")?;
+            let curve = self.curve(&s, 2)?;
+            let (t0, t1) = curve.space_curve().domain();
+            let (start, end) = match ends {
+                _ if t0.is_finite() && t1.is_finite() && t0 < t1 => {
+                    (curve.point(t0), curve.point(t1))
+                }
+                Some((a, b)) if same_sense => (a, b),
+                Some((a, b)) => (b, a),
+                None => return Err(s.error("expected a bounded parent curve")),
+            };
+            // A parent that closes on itself (a whole circle, a closed B-spline) is one
+            // edge around it, as an edge on a single vertex is (ends equal within
+            // rounding, as `Curve::closed_period` takes them).
+            let closed = start.distance(end) <= 1e-9 * (1.0 + start.abs().max_element());
+            Ok(OrientedEdge {
+                orientation: same_sense,
+                edge: Arc::new(Edge {
+                    id: s.inst.id,
+                    start,
+                    end,
+                    closed,
+                    curve,
+                    same_sense: true,
+                }),
+            })
+        })
     }
 
     fn edge(&self, from: &Rec, id: u64) -> Result<Arc<Edge>, ParseError> {
