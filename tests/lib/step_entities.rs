@@ -405,7 +405,7 @@ fn cone_sphere_and_torus_faces_match_their_definitions() {
 
 /// SURFACE_OF_REVOLUTION of a quadratic B-spline profile and SURFACE_OF_LINEAR_EXTRUSION
 /// of an ELLIPSE, bounded by their iso-curves (B_SPLINE_CURVE_WITH_KNOTS, CIRCLE,
-/// TRIMMED_CURVE of the ellipse, LINE).
+/// TRIMMED_CURVE of the ellipse by parameters or by points, LINE).
 #[test]
 fn revolution_and_extrusion_faces_match_their_definitions() {
     // Revolution: profile in the xz plane, axis z through the origin.
@@ -449,46 +449,59 @@ fn revolution_and_extrusion_faces_match_their_definitions() {
     assert_close(lo, DVec2::new(0.0, 0.0), 1e-9, "revolution low");
     assert_close(hi, DVec2::new(u1, 1.0), 1e-9, "revolution high");
 
-    // Extrusion of an ellipse arc along d.
-    let (a, b_axis) = (2.0, 1.0);
-    let d = DVec3::new(0.2, 0.0, 1.0) * 2.0;
-    let ell = move |t: f64| DVec3::new(a * t.cos(), b_axis * t.sin(), 0.0);
-    let ext = move |u: f64, v: f64| ell(u) + v * d;
-    let mut w = StepWriter::default();
-    let ax = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
-    let e = w.add(format!(
-        "ELLIPSE('',#{ax},{},{})",
-        step_support::real(a),
-        step_support::real(b_axis)
-    ));
-    let dir = w.dir(d.normalize());
-    let vec = w.add(format!(
-        "VECTOR('',#{dir},{})",
-        step_support::real(d.length())
-    ));
-    let surf = w.add(format!("SURFACE_OF_LINEAR_EXTRUSION('',#{e},#{vec})"));
-    let (t0, t1) = (0.3, 2.0);
-    let trimmed = w.add(format!(
-        "TRIMMED_CURVE('',#{e},(PARAMETER_VALUE({})),(PARAMETER_VALUE({})),.T.,.PARAMETER.)",
-        step_support::real(t0),
-        step_support::real(t1)
-    ));
-    let ax_top = w.axis(d, DVec3::Z, DVec3::X);
-    let e_top = w.add(format!(
-        "ELLIPSE('',#{ax_top},{},{})",
-        step_support::real(a),
-        step_support::real(b_axis)
-    ));
-    let corners = [ext(t0, 0.0), ext(t1, 0.0), ext(t1, 1.0), ext(t0, 1.0)];
-    let l1 = w.line(corners[1], d);
-    let l0 = w.line(corners[0], d);
-    w.rect_face(surf, corners, [trimmed, l1, e_top, l0]);
-    let s = only_surface(&w.finish());
-    let err = worst_error(&s, ext, 2.0);
-    assert!(err <= 1e-12, "extrusion: relative error {err}");
-    let (lo, hi) = mapped_domain(&s);
-    assert_close(lo, DVec2::new(t0, 0.0), 1e-9, "extrusion low");
-    assert_close(hi, DVec2::new(t1, 1.0), 1e-9, "extrusion high");
+    for by_point in [false, true] {
+        // Extrusion of an ellipse arc along d.
+        let (a, b_axis) = (2.0, 1.0);
+        let d = DVec3::new(0.2, 0.0, 1.0) * 2.0;
+        let ell = move |t: f64| DVec3::new(a * t.cos(), b_axis * t.sin(), 0.0);
+        let ext = move |u: f64, v: f64| ell(u) + v * d;
+        let mut w = StepWriter::default();
+        let ax = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
+        let e = w.add(format!(
+            "ELLIPSE('',#{ax},{},{})",
+            step_support::real(a),
+            step_support::real(b_axis)
+        ));
+        let dir = w.dir(d.normalize());
+        let vec = w.add(format!(
+            "VECTOR('',#{dir},{})",
+            step_support::real(d.length())
+        ));
+        let surf = w.add(format!("SURFACE_OF_LINEAR_EXTRUSION('',#{e},#{vec})"));
+        let (t0, t1) = (0.3, 2.0);
+        // Trimmed by parameter values, or (as UG writes them) by the points alone.
+        let trimmed = if by_point {
+            let (p0, p1) = (w.point(ell(t0)), w.point(ell(t1)));
+            w.add(format!(
+                "TRIMMED_CURVE('',#{e},(#{p0}),(#{p1}),.T.,.CARTESIAN.)"
+            ))
+        } else {
+            w.add(format!(
+                "TRIMMED_CURVE('',#{e},(PARAMETER_VALUE({})),(PARAMETER_VALUE({})),.T.,.PARAMETER.)",
+                step_support::real(t0),
+                step_support::real(t1)
+            ))
+        };
+        let ax_top = w.axis(d, DVec3::Z, DVec3::X);
+        let e_top = w.add(format!(
+            "ELLIPSE('',#{ax_top},{},{})",
+            step_support::real(a),
+            step_support::real(b_axis)
+        ));
+        let corners = [ext(t0, 0.0), ext(t1, 0.0), ext(t1, 1.0), ext(t0, 1.0)];
+        let l1 = w.line(corners[1], d);
+        let l0 = w.line(corners[0], d);
+        w.rect_face(surf, corners, [trimmed, l1, e_top, l0]);
+        let s = only_surface(&w.finish());
+        let err = worst_error(&s, ext, 2.0);
+        assert!(
+            err <= 1e-12,
+            "extrusion (by point {by_point}): relative error {err}"
+        );
+        let (lo, hi) = mapped_domain(&s);
+        assert_close(lo, DVec2::new(t0, 0.0), 1e-9, "extrusion low");
+        assert_close(hi, DVec2::new(t1, 1.0), 1e-9, "extrusion high");
+    }
 }
 
 /// B_SPLINE_SURFACE_WITH_KNOTS (bicubic, non-uniform knots), its rational complex form,

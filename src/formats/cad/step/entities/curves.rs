@@ -184,24 +184,35 @@ impl<'e, 'a> Resolver<'e, 'a> {
         let basis = self.curve(r, 1)?;
         let conic = matches!(*basis, Curve::Circle { .. } | Curve::Ellipse { .. });
         let scale = if conic { self.angle_unit } else { 1.0 };
+        // A trim select is a parameter value or a point on the basis curve (ISO 10303-42
+        // §4.3.37); the parameter is taken where both are given, a point alone gives the
+        // parameter of the basis curve's point nearest it (UG writes the bounds of its
+        // CURVE_BOUNDED_SURFACEs so).
         let trim = |i: usize| -> Result<f64, ParseError> {
             let p = r.param(i, "a trim select")?;
-            for item in r.list_of(p, "trim selects")? {
+            let selects = r.list_of(p, "trim selects")?;
+            for item in selects {
                 if let Value::Typed("PARAMETER_VALUE", inner) = &item.value {
                     return Ok(r.number(inner, "a parameter value")? * scale);
                 }
             }
-            *self.unsupported.borrow_mut() = Some("TRIMMED_CURVE trimmed by points".into());
+            for item in selects {
+                if let Value::Ref(id) = item.value {
+                    let point = self.expect_type(r, id, &["CARTESIAN_POINT"], i)?;
+                    return Ok(basis.parameter_of(self.coordinates(&point, 1, "coordinates")?));
+                }
+            }
             Err(r.error_at(
                 p.line,
                 p.column,
-                "expected a PARAMETER_VALUE among the trim selects (trims by point alone are not supported)",
+                "expected a PARAMETER_VALUE or a CARTESIAN_POINT among the trim selects",
             ))
         };
+        let (t0, t1) = (trim(2)?, trim(3)?);
         Ok(Curve::Trimmed {
             basis,
-            t0: trim(2)?,
-            t1: trim(3)?,
+            t0,
+            t1,
             sense: r.boolean(4, "sense_agreement")?,
         })
     }
