@@ -301,14 +301,7 @@ fn stage_reads_the_camera_lights_materials_and_shares_the_instances() {
             .expect("the bound UsdPreviewSurface");
         assert_eq!(red.diffuse, glam::Vec3::new(0.8, 0.1, 0.1));
         assert!((red.specular - 0.7).abs() < 1e-6 && red.transmit == 0.0);
-        let shared: Vec<_> = scene
-            .objects
-            .iter()
-            .filter_map(|o| match &o.geometry {
-                Geometry::Instance(i) => Some(std::sync::Arc::as_ptr(&i.geometry)),
-                _ => None,
-            })
-            .collect();
+        let shared = instanced_geometries(&scene);
         assert_eq!(shared.len(), 3, "{ext}: three instanceable copies");
         assert!(
             shared.iter().all(|&p| p == shared[0]),
@@ -384,14 +377,7 @@ def Camera "Cam"
     let (scene, _) = load_scene_noted(&ron, LoadOptions::default()).unwrap();
     assert_eq!(scene.objects.len(), 2);
     assert_eq!(scene.trim_loop_count(), 4, "two loops on each copy");
-    let shared: Vec<_> = scene
-        .objects
-        .iter()
-        .filter_map(|o| match &o.geometry {
-            Geometry::Instance(i) => Some(std::sync::Arc::as_ptr(&i.geometry)),
-            _ => None,
-        })
-        .collect();
+    let shared = instanced_geometries(&scene);
     assert_eq!(shared.len(), 2);
     assert_eq!(shared[0], shared[1], "one shared copy");
     assert!((scene.camera.eye - DVec3::new(0.0, -12.0, 4.0)).length() < 1e-12);
@@ -413,4 +399,17 @@ def Camera "Cam"
         a[0].is_some() && a[1].is_some() && a[2].is_none() && a[3].is_none(),
         "{a:?}"
     );
+}
+
+/// The shared geometry each instance object places, by address: equal addresses are one
+/// copy.
+fn instanced_geometries(scene: &patchtrace::scene::model::Scene) -> Vec<*const Geometry> {
+    scene
+        .objects
+        .iter()
+        .filter_map(|o| match &o.geometry {
+            Geometry::Instance(i) => Some(std::sync::Arc::as_ptr(&i.geometry)),
+            _ => None,
+        })
+        .collect()
 }
