@@ -182,13 +182,17 @@ fn closed_form_agrees_with_cramer_and_the_f64_reference_on_random_rays() {
                     // search's 8 ulps).
                     let width = (b.max - b.min).max_element();
                     assert!(width <= 4.0 * ulp_of(scale), "box {width} wide");
-                    // The f64 reference kernel's hit, in ulps of the patch scale.
-                    let reference = intersect_f64(&p, ro, rd, 0.0, f64::INFINITY, &cfg, None)
-                        .expect("the f64 reference hits too");
-                    let err = (reference.hit_box.center() - (ro + f64::from(h.t) * rd))
-                        .abs()
-                        .max_element();
-                    assert!(err <= 4.0 * ulp_of(scale), "{err} off the f64 reference");
+                    // The f64 reference kernel's hit, in ulps of the patch scale: on every
+                    // grazing ray (the hard case) and every eighth other one (the reference's
+                    // search is most of this test's time).
+                    if k % 4 == 0 || k % 8 == 1 {
+                        let reference = intersect_f64(&p, ro, rd, 0.0, f64::INFINITY, &cfg, None)
+                            .expect("the f64 reference hits too");
+                        let err = (reference.hit_box.center() - (ro + f64::from(h.t) * rd))
+                            .abs()
+                            .max_element();
+                        assert!(err <= 4.0 * ulp_of(scale), "{err} off the f64 reference");
+                    }
                     hits += 1;
                     grazing += usize::from(k % 4 == 0);
                 }
