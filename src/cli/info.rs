@@ -64,9 +64,14 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
         if let Some(sd) = &o.subdivision {
             writeln!(
                 out,
-                "    Catmull–Clark cage: {} vertices, {} faces -> {} quads; {} regular patches, {} extraordinary ends, {} T-junctions, {} levels",
+                "    Catmull–Clark cage: {} vertices, {} faces{} -> {} quads; {} regular patches, {} extraordinary ends, {} T-junctions, {} levels",
                 sd.cage_vertices,
                 sd.cage_faces,
+                if sd.holes > 0 {
+                    format!(" ({} holes)", sd.holes)
+                } else {
+                    String::new()
+                },
                 sd.quads,
                 sd.regular_patches,
                 sd.extraordinary_ends,

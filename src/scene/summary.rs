@@ -39,6 +39,8 @@ pub struct CameraSummary {
 pub struct SubdivisionSummary {
     pub cage_vertices: usize,
     pub cage_faces: usize,
+    /// Cage faces that are holes (no limit patch).
+    pub holes: usize,
     /// Quads after the first Catmull–Clark step (the `trace` patch numbers).
     pub quads: usize,
     pub regular_patches: usize,
@@ -157,6 +159,7 @@ pub fn summarize(scene: &Scene) -> SceneSummary {
             Geometry::Subdivision(sd) => Some(SubdivisionSummary {
                 cage_vertices: sd.cage.points.len(),
                 cage_faces: sd.stats.cage_faces,
+                holes: sd.stats.holes,
                 quads: sd.stats.faces,
                 regular_patches: sd.stats.regular,
                 extraordinary_ends: sd.stats.extraordinary_ends,
