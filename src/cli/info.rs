@@ -91,6 +91,9 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
         }
     )?;
     writeln!(out, "bounds: {:?} .. {:?}", s.bounds_min, s.bounds_max)?;
+    if let Some(unit) = &s.unit {
+        writeln!(out, "unit: {unit}")?;
+    }
     writeln!(out, "materials: {}", s.materials.join(", "))?;
     writeln!(
         out,

@@ -22,6 +22,10 @@ pub struct SceneSummary {
     pub materials: Vec<String>,
     pub lights: Vec<String>,
     pub max_depth: u32,
+    /// The declared length unit in words, when the file declared one.
+    pub unit: Option<String>,
+    /// Millimetres per coordinate unit, when the file declared its unit.
+    pub millimetres_per_unit: Option<f64>,
 }
 
 #[derive(Debug, Serialize)]
@@ -219,5 +223,7 @@ pub fn summarize(scene: &Scene) -> SceneSummary {
             })
             .collect(),
         max_depth: scene.max_depth,
+        unit: scene.unit.as_ref().map(|u| u.words.clone()),
+        millimetres_per_unit: scene.unit.as_ref().map(|u| u.millimetres),
     }
 }
