@@ -416,7 +416,9 @@ impl Reader<'_> {
                 self.count_unread(prim, &kind, prims::MESH_READ)?;
                 let read = prims::mesh(prim)?;
                 self.notes.extend(read.notes);
-                self.gprim(prim, binding, read.geometry, world, out)?;
+                if let Some(geometry) = read.geometry {
+                    self.gprim(prim, binding, geometry, world, out)?;
+                }
             }
             "Camera" => {
                 self.count_unread(prim, &kind, prims::CAMERA_READ)?;
