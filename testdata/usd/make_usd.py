@@ -31,6 +31,8 @@ The stage (z up, metres) holds:
 - `/World/Scatter`: a PointInstancer at y = 8 placing the trimmed patch (prototype 0)
   and the trimmed patch raised by its own translate (prototype 1) three times, by
   protoIndices, positions, orientations (half quaternions) and scales;
+- `/World/ScatterF`: a PointInstancer at y = 14 placing prototype 0 once, turned by its
+  float `orientationsf`, which is read instead of its half `orientations`;
 - `/World/Copies/A`, `B`, `C`: instanceable prims referencing `/Part`, placed by
   translate / rotateZ / scale ops, at z = 3;
 - `/World/Cam`: a camera at (0, -12, 4) looking at the origin;
@@ -149,6 +151,18 @@ def scatter(stage, prim_path):
     inst.CreateScalesAttr([Gf.Vec3f(1, 1, 1), Gf.Vec3f(1, 1, 1), Gf.Vec3f(2, 1, 0.5)])
 
 
+def scatter_float(stage, prim_path, prototype):
+    """A PointInstancer at y = 14 whose float orientationsf (120 degrees about (1, 1, 1))
+    is to be read instead of its half orientations (none)."""
+    inst = UsdGeom.PointInstancer.Define(stage, prim_path)
+    UsdGeom.XformCommonAPI(inst).SetTranslate(Gf.Vec3d(0, 14, 0))
+    inst.CreatePrototypesRel().SetTargets([prototype])
+    inst.CreateProtoIndicesAttr([0])
+    inst.CreatePositionsAttr([Gf.Vec3f(0, 0, 0)])
+    inst.CreateOrientationsAttr([Gf.Quath(1, 0, 0, 0)])
+    inst.CreateOrientationsfAttr([Gf.Quatf(0.5, 0.5, 0.5, 0.5)])
+
+
 def build_part(fmt):
     stage = Usd.Stage.CreateNew(path(f"part.{fmt}"))
     UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z)
@@ -238,6 +252,7 @@ def build_stage(fmt):
 
     ranged_patch(stage, "/World/Ranged")
     scatter(stage, "/World/Scatter")
+    scatter_float(stage, "/World/ScatterF", "/World/Scatter/Protos/Plain")
 
     UsdGeom.Xform.Define(stage, "/World/Copies")
     placements = {

@@ -427,6 +427,11 @@ fn point_instancer_places_each_prototype_by_its_index_position_orientation_and_s
                 * *own;
             check_bump(&path, &place, 1.0, &format!("{ext} /World/Scatter[{i}]"));
         }
+        // /World/ScatterF at (0, 14, 0): its orientationsf (the cycle) wins over its
+        // orientations (none).
+        let place =
+            DAffine3::from_translation(DVec3::new(0.0, 14.0, 0.0)) * DAffine3::from_mat3(cycle);
+        check_bump(&path, &place, 1.0, &format!("{ext} /World/ScatterF[0]"));
     }
 }
 
@@ -551,7 +556,7 @@ fn stage_reads_the_camera_lights_materials_and_shares_the_instances() {
             "{notes:?}"
         );
         // The PointInstancer's prototype 0 is placed twice, shared; prototype 1 once.
-        let scattered = instanced_geometries(&scene, "/World/Scatter");
+        let scattered = instanced_geometries(&scene, "/World/Scatter[");
         assert_eq!(scattered.len(), 2, "{ext}");
         assert_eq!(scattered[0], scattered[1], "{ext}");
         // What is read is not listed as not read; the closed cubes have no boundary

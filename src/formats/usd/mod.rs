@@ -489,7 +489,9 @@ impl Reader<'_> {
 
     /// A `PointInstancer` (UsdGeomPointInstancer): prototype `protoIndices[i]` placed at
     /// `positions[i]`, turned by `orientations[i]` and scaled by `scales[i]` (scale first,
-    /// then orientation, then position), each prototype's geometry shared.
+    /// then orientation, then position), each prototype's geometry shared. The
+    /// single-precision `orientationsf`, when authored, is read instead of the half
+    /// `orientations` (it is there for the precision).
     fn point_instancer(
         &mut self,
         prim: &Prim,
@@ -500,7 +502,13 @@ impl Reader<'_> {
         self.count_unread(
             prim,
             "PointInstancer",
-            &["protoIndices", "positions", "orientations", "scales"],
+            &[
+                "protoIndices",
+                "positions",
+                "orientations",
+                "orientationsf",
+                "scales",
+            ],
         )?;
         let targets = prim
             .relationship("prototypes")
@@ -508,7 +516,10 @@ impl Reader<'_> {
             .map_err(|e| anyhow_value(prim, e))?;
         let indices = values::counts((prim, "protoIndices"))?.unwrap_or_default();
         let positions = values::points((prim, "positions"))?.unwrap_or_default();
-        let orientations = values::tuples((prim, "orientations"), 4)?.unwrap_or_default();
+        let orientations = match values::tuples((prim, "orientationsf"), 4)? {
+            Some(q) => q,
+            None => values::tuples((prim, "orientations"), 4)?.unwrap_or_default(),
+        };
         let scales = values::points((prim, "scales"))?.unwrap_or_default();
         if positions.len() != indices.len() {
             return Err(ValueError(format!(
