@@ -599,8 +599,9 @@ pub struct CompareArgs {
     pub triangles: Vec<u32>,
     /// Chord-height tolerances of adaptive, crack-free tessellations to compare, as CAD
     /// systems tessellate: a plain number is a fraction of the model's size (its bounding
-    /// box diagonal), a number ending in `mm` an absolute length in scene units
-    /// (millimetres for CAD files). Example: 0.01,0.001,0.05mm.
+    /// box diagonal), a number ending in `mm` an absolute length in millimetres when the
+    /// scene declares its unit (CAD files, USD stages' metersPerUnit), else in scene
+    /// units. Example: 0.01,0.001,0.05mm.
     #[arg(long, value_delimiter = ',', value_parser = parse_tolerance)]
     pub tolerance: Vec<Tolerance>,
     /// Meshes to compare with the direct render (.stl, .obj, .gltf, .glb), such as the one
@@ -720,7 +721,7 @@ mod tests {
 pub enum Tolerance {
     /// A fraction of the model's bounding box diagonal.
     Relative(f64),
-    /// A length in scene units.
+    /// A length in millimetres (scene units when the scene declares no unit).
     Absolute(f64),
 }
 

@@ -172,7 +172,11 @@ pub fn run(args: CompareArgs) -> anyhow::Result<ExitCode> {
         .chain(args.tolerance.iter().map(|t| {
             let (label, tolerance) = match *t {
                 Tolerance::Relative(f) => (format!("chord {f} of the size"), f * size),
-                Tolerance::Absolute(d) => (format!("chord {d} mm"), d),
+                // Millimetres in the scene's units, when it declares them.
+                Tolerance::Absolute(d) => (
+                    format!("chord {d} mm"),
+                    d / scene.unit.as_ref().map_or(1.0, |u| u.millimetres),
+                ),
             };
             let name = format!("chord{tolerance:.3e}");
             let names = (name.clone(), format!("flip-{name}"));

@@ -64,9 +64,14 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
         if let Some(sd) = &o.subdivision {
             writeln!(
                 out,
-                "    Catmull–Clark cage: {} vertices, {} faces -> {} quads; {} regular patches, {} extraordinary ends, {} T-junctions, {} levels",
+                "    Catmull–Clark cage: {} vertices, {} faces{} -> {} quads; {} regular patches, {} extraordinary ends, {} T-junctions, {} levels",
                 sd.cage_vertices,
                 sd.cage_faces,
+                if sd.holes > 0 {
+                    format!(" ({} holes)", sd.holes)
+                } else {
+                    String::new()
+                },
                 sd.quads,
                 sd.regular_patches,
                 sd.extraordinary_ends,
@@ -86,6 +91,9 @@ pub fn run(args: InfoArgs) -> anyhow::Result<ExitCode> {
         }
     )?;
     writeln!(out, "bounds: {:?} .. {:?}", s.bounds_min, s.bounds_max)?;
+    if let Some(unit) = &s.unit {
+        writeln!(out, "unit: {unit}")?;
+    }
     writeln!(out, "materials: {}", s.materials.join(", "))?;
     writeln!(
         out,

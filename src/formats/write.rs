@@ -29,7 +29,7 @@ pub fn write_scene_as(path: &Path, scene: &crate::scene::model::Scene) -> Result
                 .map_err(|m| OutputError::invalid(path, m))?;
             write_atomic(path, |w| {
                 if let Some(unit) = &scene.unit {
-                    writeln!(w, "// {unit}")?;
+                    writeln!(w, "// {}", unit.words)?;
                 }
                 w.write_all(text.as_bytes())
             })
@@ -57,7 +57,7 @@ pub fn write_scene_as(path: &Path, scene: &crate::scene::model::Scene) -> Result
             let sheets = scene_sheets(scene).map_err(|m| OutputError::invalid(path, m))?;
             write_atomic(path, |w| {
                 if let Some(unit) = &scene.unit {
-                    writeln!(w, "# {unit}")?;
+                    writeln!(w, "# {}", unit.words)?;
                 }
                 super::obj::write_obj_sheets(w, &sheets)
             })

@@ -469,8 +469,18 @@ pub struct Scene {
     /// framing the geometry: new image sizes and `--up` do not move it.
     pub own_camera: bool,
     /// The length unit of the coordinates, when the file read declared one (a CAD file:
-    /// millimetres, and the unit it declared), in words, for writers to state.
-    pub unit: Option<String>,
+    /// millimetres; a USD stage: its `metersPerUnit`).
+    pub unit: Option<SceneUnit>,
+}
+
+/// A scene's declared length unit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneUnit {
+    /// Millimetres per coordinate unit: 1 for CAD files (read into millimetres), 1000 ·
+    /// `metersPerUnit` for a USD stage (whose coordinates are kept as they are).
+    pub millimetres: f64,
+    /// The unit in words, and what the file declared, for `info` and writers to state.
+    pub words: String,
 }
 
 /// Default recursion limit for reflection and refraction.

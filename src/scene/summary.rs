@@ -22,6 +22,10 @@ pub struct SceneSummary {
     pub materials: Vec<String>,
     pub lights: Vec<String>,
     pub max_depth: u32,
+    /// The declared length unit in words, when the file declared one.
+    pub unit: Option<String>,
+    /// Millimetres per coordinate unit, when the file declared its unit.
+    pub millimetres_per_unit: Option<f64>,
 }
 
 #[derive(Debug, Serialize)]
@@ -39,6 +43,8 @@ pub struct CameraSummary {
 pub struct SubdivisionSummary {
     pub cage_vertices: usize,
     pub cage_faces: usize,
+    /// Cage faces that are holes (no limit patch).
+    pub holes: usize,
     /// Quads after the first Catmull–Clark step (the `trace` patch numbers).
     pub quads: usize,
     pub regular_patches: usize,
@@ -157,6 +163,7 @@ pub fn summarize(scene: &Scene) -> SceneSummary {
             Geometry::Subdivision(sd) => Some(SubdivisionSummary {
                 cage_vertices: sd.cage.points.len(),
                 cage_faces: sd.stats.cage_faces,
+                holes: sd.stats.holes,
                 quads: sd.stats.faces,
                 regular_patches: sd.stats.regular,
                 extraordinary_ends: sd.stats.extraordinary_ends,
@@ -216,5 +223,7 @@ pub fn summarize(scene: &Scene) -> SceneSummary {
             })
             .collect(),
         max_depth: scene.max_depth,
+        unit: scene.unit.as_ref().map(|u| u.words.clone()),
+        millimetres_per_unit: scene.unit.as_ref().map(|u| u.millimetres),
     }
 }

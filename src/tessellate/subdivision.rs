@@ -82,7 +82,11 @@ impl<'a> Quads<'a> {
     /// a few `f32` ulps off the limit surface, the halves' do not.
     fn edge_point(&self, a: u32, b: u32, t: f64) -> (DVec3, DVec3) {
         let mut best: Option<(f64, (DVec3, DVec3))> = None;
+        // A hole's quads have no patches (the quad asking has).
         for &(q, k) in &self.sides[&edge_key(a, b)] {
+            if self.patches[q].is_empty() {
+                continue;
+            }
             let from_a = self.corners[q][k] == a;
             let (u, v) = side_param(k, if from_a { t } else { 1.0 - t });
             let (size, point) = self.eval_sized(q, u, v);
@@ -90,7 +94,7 @@ impl<'a> Quads<'a> {
                 best = Some((size, point));
             }
         }
-        best.expect("every edge has a quad").1
+        best.expect("the edge's quad that asks has patches").1
     }
 
     /// The limit surface's point and unit normal at `(u, v)` of quad `q`.
@@ -130,6 +134,7 @@ impl<'a> Quads<'a> {
         match plan {
             Plan::Uniform { grid_u, grid_v } => grid_u.max(grid_v),
             Plan::Adaptive { tolerance } => (0..self.corners.len())
+                .filter(|&q| !self.patches[q].is_empty())
                 .flat_map(|q| {
                     let curves: [&dyn Fn(f64) -> (f64, f64); 6] = [
                         &|t| (t, 0.0),

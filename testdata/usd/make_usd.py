@@ -22,7 +22,17 @@ The stage (z up, metres) holds:
 - `/World/Periodic`: a closed uniform cubic B-spline tube (uForm periodic: 8 distinct
   points and the first 3 repeated, unclamped uniform knots), linear in v, at y = 3;
 - `/World/Cube`: a Catmull-Clark cube (the default scheme) with one crease, at x = -3;
-- `/World/Tris`: two triangles with subdivisionScheme none, at y = -3;
+- `/World/Tris`: two triangles with subdivisionScheme none, at y = -3, and a quad beside
+  them (x in [1, 2]) that holeIndices drops;
+- `/World/Holed`: the cube again, at (-3, -3, 0), its -y face in holeIndices;
+- `/World/Ranged`: a bicubic patch over knots [0, 2] x [0, 1] (two u spans) with
+  uRange (0.5, 1.6) and vRange (0.2, 0.9), and a hole trimmed about (1, 0.5), at
+  x in [-6, -4], y in [2, 3];
+- `/World/Scatter`: a PointInstancer at y = 8 placing the trimmed patch (prototype 0)
+  and the trimmed patch raised by its own translate (prototype 1) three times, by
+  protoIndices, positions, orientations (half quaternions) and scales;
+- `/World/ScatterF`: a PointInstancer at y = 14 placing prototype 0 once, turned by its
+  float `orientationsf`, which is read instead of its half `orientations`;
 - `/World/Copies/A`, `B`, `C`: instanceable prims referencing `/Part`, placed by
   translate / rotateZ / scale ops, at z = 3;
 - `/World/Cam`: a camera at (0, -12, 4) looking at the origin;
@@ -41,6 +51,18 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 def path(name):
     return os.path.join(HERE, name)
+
+
+def circle_loop(cu, cv, r):
+    """A clockwise circle of radius r about (cu, cv): the 9-point rational quadratic
+    (Piegl & Tiller 7.5), points premultiplied by their weights."""
+    s = math.sqrt(0.5)
+    unit = [(1, 0, 1), (1, -1, s), (0, -1, 1), (-1, -1, s), (-1, 0, 1),
+            (-1, 1, s), (0, 1, 1), (1, 1, s), (1, 0, 1)]
+    return [Gf.Vec3d((cu + r * x) * w, (cv + r * y) * w, w) for x, y, w in unit]
+
+
+CIRCLE_KNOTS = [0, 0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 4]
 
 
 def trimmed_patch(stage, prim_path):
@@ -62,21 +84,83 @@ def trimmed_patch(stage, prim_path):
     p.CreatePointsAttr(pts)
     # Loop 1: the square, one degree-1 curve of 5 points, counter-clockwise.
     square = [(0, 0), (1, 0), (1, 1), (0, 1), (0, 0)]
-    # Loop 2: the circle of radius 0.25 about (0.5, 0.5), clockwise: the 9-point rational
-    # quadratic (Piegl & Tiller 7.5), points premultiplied by their weights.
-    s = math.sqrt(0.5)
-    unit = [(1, 0, 1), (1, -1, s), (0, -1, 1), (-1, -1, s), (-1, 0, 1),
-            (-1, 1, s), (0, 1, 1), (1, 1, s), (1, 0, 1)]
-    circle = [Gf.Vec3d((0.5 + 0.25 * x) * w, (0.5 + 0.25 * y) * w, w) for x, y, w in unit]
+    # Loop 2: the circle of radius 0.25 about (0.5, 0.5), clockwise.
     p.CreateTrimCurveCountsAttr([1, 1])
     p.CreateTrimCurveOrdersAttr([2, 3])
     p.CreateTrimCurveVertexCountsAttr([5, 9])
-    p.CreateTrimCurveKnotsAttr(
-        [0, 0, 1, 2, 3, 4, 4] + [0, 0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 4])
+    p.CreateTrimCurveKnotsAttr([0, 0, 1, 2, 3, 4, 4] + CIRCLE_KNOTS)
     p.CreateTrimCurveRangesAttr([Gf.Vec2d(0, 4), Gf.Vec2d(0, 4)])
     p.CreateTrimCurvePointsAttr(
-        [Gf.Vec3d(u, v, 1) for u, v in square] + circle)
+        [Gf.Vec3d(u, v, 1) for u, v in square] + circle_loop(0.5, 0.5, 0.25))
     return p
+
+
+def ranged_patch(stage, prim_path):
+    """A bicubic patch over two u spans, its uRange and vRange inside the knots' domain,
+    with a hole of radius 0.2 about (1, 0.5) cut by a clockwise circle alone."""
+    p = UsdGeom.NurbsPatch.Define(stage, prim_path)
+    heights = [0.0, 0.5, -0.3, 0.4, 0.1]
+    pts = [Gf.Vec3f(-6 + 0.5 * i, 2 + j / 3.0, heights[i] * (1 + 0.5 * j))
+           for j in range(4) for i in range(5)]
+    p.CreateUVertexCountAttr(5)
+    p.CreateVVertexCountAttr(4)
+    p.CreateUOrderAttr(4)
+    p.CreateVOrderAttr(4)
+    p.CreateUKnotsAttr([0, 0, 0, 0, 1, 2, 2, 2, 2])
+    p.CreateVKnotsAttr([0, 0, 0, 0, 1, 1, 1, 1])
+    p.CreateURangeAttr(Gf.Vec2d(0.5, 1.6))
+    p.CreateVRangeAttr(Gf.Vec2d(0.2, 0.9))
+    p.CreatePointsAttr(pts)
+    p.CreateTrimCurveCountsAttr([1])
+    p.CreateTrimCurveOrdersAttr([3])
+    p.CreateTrimCurveVertexCountsAttr([9])
+    p.CreateTrimCurveKnotsAttr(CIRCLE_KNOTS)
+    p.CreateTrimCurveRangesAttr([Gf.Vec2d(0, 4)])
+    p.CreateTrimCurvePointsAttr(circle_loop(1.0, 0.5, 0.2))
+    return p
+
+
+def cube_mesh(stage, prim_path, translate):
+    """The unit cube's cage (the tests' Catmull-Clark reference cube), translated."""
+    cube = UsdGeom.Mesh.Define(stage, prim_path)
+    corners = [Gf.Vec3f(x, y, z) for z in (-0.5, 0.5) for y in (-0.5, 0.5) for x in (-0.5, 0.5)]
+    cube.CreatePointsAttr(corners)
+    cube.CreateFaceVertexCountsAttr([4] * 6)
+    cube.CreateFaceVertexIndicesAttr(
+        [0, 2, 3, 1, 4, 5, 7, 6, 0, 1, 5, 4, 2, 6, 7, 3, 0, 4, 6, 2, 1, 3, 7, 5])
+    UsdGeom.XformCommonAPI(cube).SetTranslate(Gf.Vec3d(*translate))
+    return cube
+
+
+def scatter(stage, prim_path):
+    """A PointInstancer of the trimmed patch (prototype 0) and the same patch raised by
+    its own translate (prototype 1)."""
+    inst = UsdGeom.PointInstancer.Define(stage, prim_path)
+    UsdGeom.XformCommonAPI(inst).SetTranslate(Gf.Vec3d(0, 8, 0))
+    UsdGeom.Scope.Define(stage, f"{prim_path}/Protos")
+    plain = trimmed_patch(stage, f"{prim_path}/Protos/Plain")
+    raised = trimmed_patch(stage, f"{prim_path}/Protos/Raised")
+    UsdGeom.XformCommonAPI(raised).SetTranslate(Gf.Vec3d(0, 0, 0.25))
+    inst.CreatePrototypesRel().SetTargets([plain.GetPath(), raised.GetPath()])
+    inst.CreateProtoIndicesAttr([0, 1, 0])
+    inst.CreatePositionsAttr([Gf.Vec3f(0, 0, 0), Gf.Vec3f(3, 3, 0), Gf.Vec3f(6, 0, 1)])
+    # Identity; 120 degrees about (1, 1, 1) (x to y, y to z, z to x); 180 degrees about
+    # z. Each component is exact in half precision.
+    inst.CreateOrientationsAttr([Gf.Quath(1, 0, 0, 0), Gf.Quath(0.5, 0.5, 0.5, 0.5),
+                                 Gf.Quath(0, 0, 0, 1)])
+    inst.CreateScalesAttr([Gf.Vec3f(1, 1, 1), Gf.Vec3f(1, 1, 1), Gf.Vec3f(2, 1, 0.5)])
+
+
+def scatter_float(stage, prim_path, prototype):
+    """A PointInstancer at y = 14 whose float orientationsf (120 degrees about (1, 1, 1))
+    is to be read instead of its half orientations (none)."""
+    inst = UsdGeom.PointInstancer.Define(stage, prim_path)
+    UsdGeom.XformCommonAPI(inst).SetTranslate(Gf.Vec3d(0, 14, 0))
+    inst.CreatePrototypesRel().SetTargets([prototype])
+    inst.CreateProtoIndicesAttr([0])
+    inst.CreatePositionsAttr([Gf.Vec3f(0, 0, 0)])
+    inst.CreateOrientationsAttr([Gf.Quath(1, 0, 0, 0)])
+    inst.CreateOrientationsfAttr([Gf.Quatf(0.5, 0.5, 0.5, 0.5)])
 
 
 def build_part(fmt):
@@ -148,24 +232,27 @@ def build_stage(fmt):
     pr.CreatePointsAttr(pts)
     UsdGeom.XformCommonAPI(pr).SetTranslate(Gf.Vec3d(0, 3, 0))
 
-    cube = UsdGeom.Mesh.Define(stage, "/World/Cube")
-    corners = [Gf.Vec3f(x, y, z) for z in (-0.5, 0.5) for y in (-0.5, 0.5) for x in (-0.5, 0.5)]
-    cube.CreatePointsAttr(corners)
-    cube.CreateFaceVertexCountsAttr([4] * 6)
-    cube.CreateFaceVertexIndicesAttr(
-        [0, 2, 3, 1, 4, 5, 7, 6, 0, 1, 5, 4, 2, 6, 7, 3, 0, 4, 6, 2, 1, 3, 7, 5])
+    cube = cube_mesh(stage, "/World/Cube", (-3, 0, 0))
     cube.CreateCreaseIndicesAttr([4, 5])
     cube.CreateCreaseLengthsAttr([2])
     cube.CreateCreaseSharpnessesAttr([2.0])
     cube.CreateDisplayColorAttr([Gf.Vec3f(0.2, 0.4, 0.9)])
-    UsdGeom.XformCommonAPI(cube).SetTranslate(Gf.Vec3d(-3, 0, 0))
+
+    # Face 2, (0, 1, 5, 4), is the cube's -y side.
+    cube_mesh(stage, "/World/Holed", (-3, -3, 0)).CreateHoleIndicesAttr([2])
 
     tris = UsdGeom.Mesh.Define(stage, "/World/Tris")
-    tris.CreatePointsAttr([Gf.Vec3f(0, 0, 0), Gf.Vec3f(1, 0, 0), Gf.Vec3f(1, 0, 1), Gf.Vec3f(0, 0, 1)])
-    tris.CreateFaceVertexCountsAttr([3, 3])
-    tris.CreateFaceVertexIndicesAttr([0, 1, 2, 0, 2, 3])
+    tris.CreatePointsAttr([Gf.Vec3f(0, 0, 0), Gf.Vec3f(1, 0, 0), Gf.Vec3f(1, 0, 1), Gf.Vec3f(0, 0, 1),
+                           Gf.Vec3f(2, 0, 0), Gf.Vec3f(2, 0, 1)])
+    tris.CreateFaceVertexCountsAttr([3, 3, 4])
+    tris.CreateFaceVertexIndicesAttr([0, 1, 2, 0, 2, 3, 1, 4, 5, 2])
+    tris.CreateHoleIndicesAttr([2])
     tris.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
     UsdGeom.XformCommonAPI(tris).SetTranslate(Gf.Vec3d(0, -3, 0))
+
+    ranged_patch(stage, "/World/Ranged")
+    scatter(stage, "/World/Scatter")
+    scatter_float(stage, "/World/ScatterF", "/World/Scatter/Protos/Plain")
 
     UsdGeom.Xform.Define(stage, "/World/Copies")
     placements = {

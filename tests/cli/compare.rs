@@ -266,3 +266,47 @@ fn surface_error_is_rounding_on_a_plane_and_not_on_a_coarse_teapot() {
     assert!(errors[0][0] < 1e-5, "plane: {:?}", errors[0]);
     assert!(errors[1][2] > 1e-3 * 7.0, "teapot: {:?}", errors[1]);
 }
+
+/// `compare --tolerance 0.5mm` on a USD stage in centimetres (metersPerUnit 0.01) is a
+/// chord of 0.05 stage units, so its images are named for 5e-2; the bare teapot, which
+/// declares no unit, keeps millimetres as its own units (the test above).
+#[test]
+fn an_absolute_tolerance_is_millimetres_in_a_usd_stages_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let part = std::fs::read_to_string(testdata("usd/part.usda")).unwrap();
+    let stage = dir.path().join("part_cm.usda");
+    std::fs::write(
+        &stage,
+        part.replacen("metersPerUnit = 1\n", "metersPerUnit = 0.01\n", 1),
+    )
+    .unwrap();
+    let out = dir.path().join("cmp");
+    let o = run(&[
+        "compare",
+        stage.to_str().unwrap(),
+        "--tolerance",
+        "0.5mm",
+        "--out-dir",
+        out.to_str().unwrap(),
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        out.join("chord5.000e-2.png").exists(),
+        "{:?}",
+        std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect::<Vec<_>>()
+    );
+    let o = run(&["info", stage.to_str().unwrap(), "-q"]);
+    assert!(
+        stdout(&o).contains("unit: lengths in stage units of 10 mm"),
+        "{}",
+        stdout(&o)
+    );
+}

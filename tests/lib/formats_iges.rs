@@ -1642,8 +1642,15 @@ fn inch_file_is_read_into_millimetres() {
         patchtrace::formats::cad::scene::build_scene(Path::new("inch.igs"), read.into_model())
             .unwrap();
     assert_eq!(
-        built.scene.unit.as_deref(),
-        Some("lengths in millimetres (the IGES file declares INCH, 25.4 mm)")
+        built
+            .scene
+            .unit
+            .as_ref()
+            .map(|u| (u.millimetres, u.words.as_str())),
+        Some((
+            1.0,
+            "lengths in millimetres (the IGES file declares INCH, 25.4 mm)"
+        ))
     );
     let surfaces = built.scene.objects[0].geometry.surfaces();
     assert_eq!(surfaces.len(), 1);

@@ -110,12 +110,14 @@ fn bump_samples() -> (Samples, Samples) {
     (kept, cut)
 }
 
-/// Vertical rays onto `place`d copies of the bump at (u, v), from `side` (+1 above, -1
-/// below): every kept sample is hit at its de Boor point, every cut one missed.
+/// Rays along the bump's placed z axis onto `place`d copies of it at (u, v), from `side`
+/// (+1 above, -1 below): every kept sample is hit at its de Boor point, every cut one
+/// missed.
 fn check_bump(path: &std::path::Path, place: &DAffine3, side: f64, what: &str) {
     let patch = bump();
     let (kept, cut) = bump_samples();
-    let above = |p: DVec3| (p + DVec3::Z * 20.0 * side, -DVec3::Z * side);
+    let up = place.transform_vector3(DVec3::Z).normalize() * side;
+    let above = |p: DVec3| (p + up * 20.0, -up);
     let kept_points: Vec<DVec3> = kept
         .iter()
         .map(|&(u, v)| place.transform_point3(patch.eval(u, v)))
@@ -274,6 +276,241 @@ fn the_cube_mesh_is_its_catmull_clark_limit_surface_and_the_none_mesh_is_flat() 
                 "{ext}: {h}"
             );
         }
+        // The quad beside them, x in [1, 2], is in holeIndices: nothing is hit there.
+        let through = [(DVec3::new(1.5, -5.0, 0.5), DVec3::Y)];
+        assert_eq!(
+            trace_hits(&path, &through),
+            vec![None],
+            "{ext}: the hole quad"
+        );
+    }
+}
+
+#[test]
+fn a_hole_face_is_missed_and_its_neighbours_are_the_whole_cubes_limit_surface() {
+    // /World/Holed is the reference cube at (-3, -3, 0) with face 2 (its -y side) a
+    // hole. Two global steps of the reference: face f's 16 grandchildren are 16 f ..
+    // 16 f + 15 (every face a quad). A vertex whose faces all descend from the hole lies
+    // inside it, one with none of them outside; those on its rim are left out.
+    let offset = DVec3::new(-3.0, -3.0, 0.0);
+    let (m, _) = cube().subdivide(2);
+    let in_hole = |f: usize| f / 16 == 2;
+    let (mut kept, mut cut) = (Vec::new(), Vec::new());
+    for v in 0..m.p.len() {
+        let faces: Vec<usize> = (0..m.f.len()).filter(|&f| m.f[f].contains(&v)).collect();
+        let Some(p) = m.limit(v, &|_, _| false) else {
+            continue;
+        };
+        if faces.iter().all(|&f| in_hole(f)) {
+            cut.push(p + offset);
+        } else if !faces.iter().any(|&f| in_hole(f)) {
+            kept.push(p + offset);
+        }
+    }
+    assert_eq!(cut.len(), 9, "the hole's inner vertices");
+    assert!(kept.len() > 40);
+    for ext in FORMATS {
+        let path = testdata(&format!("usd/stage.{ext}"));
+        let rays: Vec<_> = kept.iter().map(|&p| (offset, p - offset)).collect();
+        for (p, hit) in kept.iter().zip(trace_hits(&path, &rays)) {
+            let (h, _) = hit.unwrap_or_else(|| panic!("{ext} holed cube: limit point {p} missed"));
+            assert!(
+                (h - *p).length() < TOLERANCE,
+                "{ext} holed cube: hit {h}, limit {p}"
+            );
+        }
+        // Out through the hole, towards -y, where the stage has nothing.
+        let rays: Vec<_> = cut.iter().map(|&p| (offset, p - offset)).collect();
+        for (p, hit) in cut.iter().zip(trace_hits(&path, &rays)) {
+            assert!(
+                hit.is_none(),
+                "{ext}: the ray through {p} in the hole hit {hit:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_patch_with_a_narrower_range_is_hit_only_inside_it_at_its_de_boor_points() {
+    // /World/Ranged (make_usd.py, `ranged_patch`): x depends on u alone and y on v alone,
+    // so a vertical ray at a de Boor point of the whole patch meets the patch there if
+    // (u, v) is in uRange x vRange and outside the trimmed hole, and nothing otherwise.
+    let heights = [0.0, 0.5, -0.3, 0.4, 0.1];
+    let mut points = Vec::new();
+    for j in 0..4 {
+        for (i, h) in heights.iter().enumerate() {
+            points.push(DVec4::new(
+                f32ed(-6.0 + 0.5 * i as f64),
+                f32ed(2.0 + j as f64 / 3.0),
+                f32ed(h * (1.0 + 0.5 * j as f64)),
+                1.0,
+            ));
+        }
+    }
+    let patch = Patch {
+        degree: (3, 3),
+        knots: (
+            vec![0.0, 0.0, 0.0, 0.0, 1.0, 2.0, 2.0, 2.0, 2.0],
+            vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0],
+        ),
+        count_u: 5,
+        points,
+    };
+    let margin = 0.02;
+    let (mut kept, mut cut) = (Vec::new(), Vec::new());
+    for a in 0..20 {
+        for b in 0..10 {
+            let (u, v) = (0.05 + 0.1 * a as f64, 0.05 + 0.1 * b as f64);
+            let inside = |x: f64, lo: f64, hi: f64| x > lo + margin && x < hi - margin;
+            let outside = |x: f64, lo: f64, hi: f64| x < lo - margin || x > hi + margin;
+            let r = ((u - 1.0).powi(2) + (v - 0.5).powi(2)).sqrt();
+            if inside(u, 0.5, 1.6) && inside(v, 0.2, 0.9) && r > 0.2 + margin {
+                kept.push((u, v));
+            } else if outside(u, 0.5, 1.6) || outside(v, 0.2, 0.9) || r < 0.2 - margin {
+                cut.push((u, v));
+            }
+        }
+    }
+    assert!(kept.len() > 30 && cut.len() > 100);
+    let ray = |&(u, v): &(f64, f64)| {
+        let p = patch.eval(u, v);
+        (DVec3::new(p.x, p.y, 20.0), -DVec3::Z)
+    };
+    for ext in FORMATS {
+        let path = testdata(&format!("usd/stage.{ext}"));
+        let hits = trace_hits(&path, &kept.iter().map(ray).collect::<Vec<_>>());
+        for (uv, hit) in kept.iter().zip(hits) {
+            let p = patch.eval(uv.0, uv.1);
+            let (h, _) = hit.unwrap_or_else(|| panic!("{ext} {uv:?}: {p} in range missed"));
+            assert!(
+                (h - p).length() < TOLERANCE,
+                "{ext} {uv:?}: hit {h}, de Boor {p}"
+            );
+        }
+        let hits = trace_hits(&path, &cut.iter().map(ray).collect::<Vec<_>>());
+        for (uv, hit) in cut.iter().zip(hits) {
+            assert!(
+                hit.is_none(),
+                "{ext} {uv:?}: outside the range or in the hole, hit {hit:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn point_instancer_places_each_prototype_by_its_index_position_orientation_and_scale() {
+    // /World/Scatter (make_usd.py, `scatter`): at (0, 8, 0); prototype 1 is the bump
+    // raised by its own translate (0, 0, 0.25). Instance i is the instancer's placement,
+    // then positions[i], orientations[i], scales[i], then the prototype's own transform.
+    // The orientations as the rotations they are: none; 120 degrees about (1, 1, 1),
+    // which takes x to y, y to z and z to x; 180 degrees about z.
+    let cycle = DMat3::from_cols(DVec3::Y, DVec3::Z, DVec3::X);
+    let half_turn = DMat3::from_cols(-DVec3::X, -DVec3::Y, DVec3::Z);
+    let raised = DAffine3::from_translation(DVec3::new(0.0, 0.0, 0.25));
+    let instances = [
+        (DVec3::ZERO, DMat3::IDENTITY, DVec3::ONE, DAffine3::IDENTITY),
+        (DVec3::new(3.0, 3.0, 0.0), cycle, DVec3::ONE, raised),
+        (
+            DVec3::new(6.0, 0.0, 1.0),
+            half_turn,
+            DVec3::new(2.0, 1.0, 0.5),
+            DAffine3::IDENTITY,
+        ),
+    ];
+    for ext in FORMATS {
+        let path = testdata(&format!("usd/stage.{ext}"));
+        for (i, (position, turn, scale, own)) in instances.iter().enumerate() {
+            let place = DAffine3::from_translation(DVec3::new(0.0, 8.0, 0.0))
+                * DAffine3::from_translation(*position)
+                * DAffine3::from_mat3(*turn)
+                * DAffine3::from_scale(*scale)
+                * *own;
+            check_bump(&path, &place, 1.0, &format!("{ext} /World/Scatter[{i}]"));
+        }
+        // /World/ScatterF at (0, 14, 0): its orientationsf (the cycle) wins over its
+        // orientations (none).
+        let place =
+            DAffine3::from_translation(DVec3::new(0.0, 14.0, 0.0)) * DAffine3::from_mat3(cycle);
+        check_bump(&path, &place, 1.0, &format!("{ext} /World/ScatterF[0]"));
+    }
+}
+
+#[test]
+fn boundary_corners_under_edge_and_corner_are_noted_and_edge_only_is_not() {
+    // A 2 x 2 grid of quads: four boundary corner vertices (one face each).
+    let dir = tempfile::tempdir().unwrap();
+    let grid = |name: &str, rule: &str| {
+        format!(
+            r#"def Mesh "{name}"
+{{
+    point3f[] points = [(0,0,0),(1,0,0),(2,0,0),(0,1,0),(1,1,1),(2,1,0),(0,2,0),(1,2,0),(2,2,0)]
+    int[] faceVertexCounts = [4, 4, 4, 4]
+    int[] faceVertexIndices = [0,1,4,3, 1,2,5,4, 3,4,7,6, 4,5,8,7]
+    {rule}
+}}
+"#
+        )
+    };
+    let text = format!(
+        "#usda 1.0\n(\n    upAxis = \"Z\"\n)\n{}{}{}",
+        grid("Fallback", ""),
+        grid("EdgeOnly", r#"token interpolateBoundary = "edgeOnly""#),
+        grid("NoBoundary", r#"token interpolateBoundary = "none""#),
+    );
+    let path = dir.path().join("grids.usda");
+    std::fs::write(&path, text).unwrap();
+    let (_, notes) = load_scene_noted(&path, LoadOptions::default()).unwrap();
+    let about = |prim: &str| -> Vec<&String> {
+        notes
+            .iter()
+            .filter(|n| n.starts_with(prim) && n.contains("interpolateBoundary"))
+            .collect()
+    };
+    let fallback = about("/Fallback:");
+    assert!(
+        fallback.len() == 1 && fallback[0].contains("at 4 boundary corner vertices"),
+        "{notes:?}"
+    );
+    assert!(about("/EdgeOnly:").is_empty(), "{notes:?}");
+    assert_eq!(about("/NoBoundary:").len(), 1, "{notes:?}");
+    assert!(
+        !notes.iter().any(|n| n.starts_with("not read")),
+        "{notes:?}"
+    );
+}
+
+#[test]
+fn the_stage_unit_is_meters_per_unit_or_usds_centimetre_fallback() {
+    let dir = tempfile::tempdir().unwrap();
+    for (metadata, millimetres) in [("metersPerUnit = 0.0254", 25.4), ("", 10.0)] {
+        let path = dir.path().join("unit.usda");
+        std::fs::write(
+            &path,
+            format!(
+                r#"#usda 1.0
+(
+    {metadata}
+)
+def Mesh "M"
+{{
+    point3f[] points = [(0,0,0),(1,0,0),(0,1,0)]
+    int[] faceVertexCounts = [3]
+    int[] faceVertexIndices = [0,1,2]
+    token subdivisionScheme = "none"
+}}
+"#
+            ),
+        )
+        .unwrap();
+        let (scene, _) = load_scene_noted(&path, LoadOptions::default()).unwrap();
+        let unit = scene.unit.as_ref().expect("a USD stage has a unit");
+        assert!(
+            (unit.millimetres - millimetres).abs() < 1e-12,
+            "{}",
+            unit.words
+        );
+        // Coordinates stay in stage units.
+        assert_eq!(scene.bounds().max.x, 1.0);
     }
 }
 
@@ -301,7 +538,12 @@ fn stage_reads_the_camera_lights_materials_and_shares_the_instances() {
             .expect("the bound UsdPreviewSurface");
         assert_eq!(red.diffuse, glam::Vec3::new(0.8, 0.1, 0.1));
         assert!((red.specular - 0.7).abs() < 1e-6 && red.transmit == 0.0);
-        let shared = instanced_geometries(&scene);
+        assert_eq!(
+            scene.unit.as_ref().map(|u| u.millimetres),
+            Some(1000.0),
+            "{ext}: metersPerUnit 1"
+        );
+        let shared = instanced_geometries(&scene, "/World/Copies/");
         assert_eq!(shared.len(), 3, "{ext}: three instanceable copies");
         assert!(
             shared.iter().all(|&p| p == shared[0]),
@@ -311,6 +553,26 @@ fn stage_reads_the_camera_lights_materials_and_shares_the_instances() {
             notes
                 .iter()
                 .any(|n| n.contains("creaseIndices not honoured")),
+            "{notes:?}"
+        );
+        // The PointInstancer's prototype 0 is placed twice, shared; prototype 1 once.
+        let scattered = instanced_geometries(&scene, "/World/Scatter[");
+        assert_eq!(scattered.len(), 2, "{ext}");
+        assert_eq!(scattered[0], scattered[1], "{ext}");
+        // What is read is not listed as not read; the closed cubes have no boundary
+        // corners to note.
+        let unread = notes.iter().find(|n| n.starts_with("not read")).unwrap();
+        for read in [
+            "holeIndices",
+            "uRange",
+            "vRange",
+            "PointInstancer",
+            "orientations",
+        ] {
+            assert!(!unread.contains(read), "{ext}: {unread}");
+        }
+        assert!(
+            !notes.iter().any(|n| n.contains("interpolateBoundary")),
             "{notes:?}"
         );
     }
@@ -377,7 +639,7 @@ def Camera "Cam"
     let (scene, _) = load_scene_noted(&ron, LoadOptions::default()).unwrap();
     assert_eq!(scene.objects.len(), 2);
     assert_eq!(scene.trim_loop_count(), 4, "two loops on each copy");
-    let shared = instanced_geometries(&scene);
+    let shared = instanced_geometries(&scene, "");
     assert_eq!(shared.len(), 2);
     assert_eq!(shared[0], shared[1], "one shared copy");
     assert!((scene.camera.eye - DVec3::new(0.0, -12.0, 4.0)).length() < 1e-12);
@@ -401,12 +663,16 @@ def Camera "Cam"
     );
 }
 
-/// The shared geometry each instance object places, by address: equal addresses are one
-/// copy.
-fn instanced_geometries(scene: &patchtrace::scene::model::Scene) -> Vec<*const Geometry> {
+/// The shared geometry each instance object named from `prefix` places, by address:
+/// equal addresses are one copy.
+fn instanced_geometries(
+    scene: &patchtrace::scene::model::Scene,
+    prefix: &str,
+) -> Vec<*const Geometry> {
     scene
         .objects
         .iter()
+        .filter(|o| o.name.starts_with(prefix))
         .filter_map(|o| match &o.geometry {
             Geometry::Instance(i) => Some(std::sync::Arc::as_ptr(&i.geometry)),
             _ => None,

@@ -184,3 +184,41 @@ fn cage_tessellation_size_is_per_quad() {
         );
     }
 }
+
+/// A hole face (USD's `holeIndices`) has no triangles, and its neighbours' sides along
+/// the hole are its rim: the cube without face 2 at 4 × 4 per quad is 20 quads' worth of
+/// triangles, and its only untwinned edges are the rim's 4 sides × 2 quads × 4 segments.
+#[test]
+fn a_hole_face_is_left_out_and_its_rim_is_the_only_boundary() {
+    let c = cube();
+    let faces =
+        c.f.iter()
+            .map(|f| f.iter().map(|&v| v as u32).collect())
+            .collect();
+    let s = SubdivisionSurface::with_holes(c.p.clone(), faces, vec![2]).unwrap();
+    assert_eq!(s.stats.holes, 1);
+    let m = tessellate(&s, 4);
+    assert_eq!(m.indices.len(), 2 * 16 * 20);
+    let mut weld: HashMap<[u64; 3], usize> = HashMap::new();
+    let ids: Vec<usize> = m
+        .positions
+        .iter()
+        .map(|p| {
+            let n = weld.len();
+            *weld.entry(p.to_array().map(f64::to_bits)).or_insert(n)
+        })
+        .collect();
+    let mut directed: HashMap<(usize, usize), usize> = HashMap::new();
+    for t in &m.indices {
+        let v = t.map(|i| ids[i as usize]);
+        for k in 0..3 {
+            *directed.entry((v[k], v[(k + 1) % 3])).or_default() += 1;
+        }
+    }
+    assert!(directed.values().all(|&n| n == 1));
+    let rim = directed
+        .keys()
+        .filter(|&&(a, b)| !directed.contains_key(&(b, a)))
+        .count();
+    assert_eq!(rim, 4 * 2 * 4);
+}

@@ -328,7 +328,10 @@ pub fn build_scene(path: &Path, model: CadModel) -> Result<CadScene, LoadError> 
     let mut scene = Scene::framing(assembled.objects);
     scene.materials = assembled.materials;
     scene.warnings = model.warning_lines(path);
-    scene.unit = Some(model.unit.in_words(model.format));
+    scene.unit = Some(crate::scene::model::SceneUnit {
+        millimetres: 1.0,
+        words: model.unit.in_words(model.format),
+    });
     Ok(CadScene {
         notes: model.info_lines(),
         scene,

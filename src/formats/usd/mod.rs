@@ -7,8 +7,8 @@
 //!
 //! - the `Xform` stack (`xformOp:*` in `xformOpOrder`, `!resetXformStack!`,
 //!   [`values::local_transform`]) and the stage's `upAxis` (a y-up stage is turned to
-//!   our z up); coordinates stay in the stage's units (`metersPerUnit` is stated, not
-//!   applied);
+//!   our z up); coordinates stay in the stage's units, and `metersPerUnit` (UsdGeom's
+//!   fallback 0.01 when unauthored) is the scene's unit ([`stage_unit`]);
 //! - an instanceable prim is one shared copy of its prototype's geometry per gprim and
 //!   one [`Instance`] per placement (Dammertz §3.3), as is each point of a
 //!   `PointInstancer`;
@@ -30,7 +30,9 @@ use openusd::sdf;
 use openusd::usd::{Prim, Stage};
 
 use super::error::{LoadError, ParseError};
-use crate::scene::model::{Axis, Camera, Geometry, Instance, Light, Material, Object, Scene};
+use crate::scene::model::{
+    Axis, Camera, Geometry, Instance, Light, Material, Object, Scene, SceneUnit,
+};
 use values::ValueError;
 
 /// What reading a USD stage gives: the scene, and facts for `info`, one line each.
@@ -96,6 +98,7 @@ pub fn read_usd(path: &Path, camera: Option<&str>) -> Result<UsdRead, LoadError>
         Some(v) => values::flatten(&v).and_then(|v| v.first().copied()),
         None => None,
     };
+    let unit = stage_unit(path, meters)?;
     let root = DAffine3::from_mat3(up.to_z_up());
     let mut reader = Reader {
         stage: &stage,
@@ -178,7 +181,7 @@ pub fn read_usd(path: &Path, camera: Option<&str>) -> Result<UsdRead, LoadError>
         scene.lights = std::mem::take(&mut reader.lights);
     }
     scene.materials = reader.materials;
-    scene.unit = meters.map(|m| format!("stage units of {m} m (metersPerUnit)"));
+    scene.unit = Some(unit);
     let mut notes = vec![format!(
         "USD stage: {} gprims, {} instances of {} prototypes, {} cameras, {} lights, up axis {}",
         reader.gprims,
@@ -203,6 +206,34 @@ pub fn read_usd(path: &Path, camera: Option<&str>) -> Result<UsdRead, LoadError>
         .map(|w| format!("warning: {}: {w}", path.display()))
         .collect();
     Ok(UsdRead { scene, notes })
+}
+
+/// UsdGeom's fallback `metersPerUnit` for a stage that does not author one
+/// (UsdGeomLinearUnits::centimeters).
+const FALLBACK_METERS_PER_UNIT: f64 = 0.01;
+
+/// The stage's length unit: coordinates stay in stage units (rays, cameras and
+/// `trace`'s hit points are the stage's own), and the unit records how long one is, for
+/// lengths given in millimetres (`compare --tolerance 0.1mm`) and for `info`.
+fn stage_unit(path: &Path, meters: Option<f64>) -> Result<SceneUnit, LoadError> {
+    let m = meters.unwrap_or(FALLBACK_METERS_PER_UNIT);
+    if !(m.is_finite() && m > 0.0) {
+        return Err(LoadError::invalid(
+            path,
+            format!("metersPerUnit {m}: expected a positive length"),
+        ));
+    }
+    let millimetres = 1000.0 * m;
+    let declared = match meters {
+        Some(_) => format!("metersPerUnit {m}"),
+        None => format!("no metersPerUnit, UsdGeom's fallback {m}"),
+    };
+    Ok(SceneUnit {
+        millimetres,
+        words: format!(
+            "lengths in stage units of {millimetres} mm (the USD stage declares {declared})"
+        ),
+    })
 }
 
 fn unread_list(unread: &BTreeMap<String, usize>) -> Option<String> {
@@ -385,7 +416,9 @@ impl Reader<'_> {
                 self.count_unread(prim, &kind, prims::MESH_READ)?;
                 let read = prims::mesh(prim)?;
                 self.notes.extend(read.notes);
-                self.gprim(prim, binding, read.geometry, world, out)?;
+                if let Some(geometry) = read.geometry {
+                    self.gprim(prim, binding, geometry, world, out)?;
+                }
             }
             "Camera" => {
                 self.count_unread(prim, &kind, prims::CAMERA_READ)?;
@@ -456,7 +489,9 @@ impl Reader<'_> {
 
     /// A `PointInstancer` (UsdGeomPointInstancer): prototype `protoIndices[i]` placed at
     /// `positions[i]`, turned by `orientations[i]` and scaled by `scales[i]` (scale first,
-    /// then orientation, then position), each prototype's geometry shared.
+    /// then orientation, then position), each prototype's geometry shared. The
+    /// single-precision `orientationsf`, when authored, is read instead of the half
+    /// `orientations` (it is there for the precision).
     fn point_instancer(
         &mut self,
         prim: &Prim,
@@ -467,7 +502,13 @@ impl Reader<'_> {
         self.count_unread(
             prim,
             "PointInstancer",
-            &["protoIndices", "positions", "orientations", "scales"],
+            &[
+                "protoIndices",
+                "positions",
+                "orientations",
+                "orientationsf",
+                "scales",
+            ],
         )?;
         let targets = prim
             .relationship("prototypes")
@@ -475,7 +516,10 @@ impl Reader<'_> {
             .map_err(|e| anyhow_value(prim, e))?;
         let indices = values::counts((prim, "protoIndices"))?.unwrap_or_default();
         let positions = values::points((prim, "positions"))?.unwrap_or_default();
-        let orientations = values::tuples((prim, "orientations"), 4)?.unwrap_or_default();
+        let orientations = match values::tuples((prim, "orientationsf"), 4)? {
+            Some(q) => q,
+            None => values::tuples((prim, "orientations"), 4)?.unwrap_or_default(),
+        };
         let scales = values::points((prim, "scales"))?.unwrap_or_default();
         if positions.len() != indices.len() {
             return Err(ValueError(format!(

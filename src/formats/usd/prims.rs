@@ -2,6 +2,8 @@
 //! UsdLux `DistantLight`, `SphereLight`; UsdShade `UsdPreviewSurface`), each from the
 //! composed prim, in the prim's own coordinates.
 
+use std::collections::HashMap;
+
 use glam::{DAffine3, DVec2, DVec3, DVec4, Vec3};
 use openusd::usd::Prim;
 
@@ -41,7 +43,9 @@ pub const MESH_READ: &[&str] = &[
     "faceVertexIndices",
     "subdivisionScheme",
     "orientation",
-    // Read to say they are not honoured (see [`mesh`]).
+    "holeIndices",
+    // Read to say what is not honoured (see [`mesh`]).
+    "interpolateBoundary",
     "creaseIndices",
     "creaseLengths",
     "creaseSharpnesses",
@@ -138,23 +142,7 @@ pub fn nurbs_patch(prim: &Prim) -> Result<(Surface, Vec<String>), ValueError> {
         .collect();
     let surface = NurbsSurface::new(ou - 1, ov - 1, knots_u, knots_v, nu, nv, homogeneous)
         .map_err(|e| bad(prim, e))?;
-    let domain = surface.domain();
-    for (name, lo, hi) in [
-        ("uRange", domain.u0, domain.u1),
-        ("vRange", domain.v0, domain.v1),
-    ] {
-        if let Some(r) = numbers((prim, name))?
-            && r.len() == 2
-            && (r[0] != lo || r[1] != hi)
-        {
-            notes.push(format!(
-                "{}: {name} ({}, {}) narrower than the knots' domain ({lo}, {hi}) is not applied",
-                prim.path(),
-                r[0],
-                r[1]
-            ));
-        }
-    }
+    let surface = ranged(prim, surface, &mut notes)?;
     let mut s = Surface {
         geometry: crate::scene::model::SurfaceGeometry::Nurbs(surface),
         trims: trim_loops(prim)?,
@@ -164,6 +152,51 @@ pub fn nurbs_patch(prim: &Prim) -> Result<(Surface, Vec<String>), ValueError> {
         s.flip_sides();
     }
     Ok((s, notes))
+}
+
+/// The surface restricted to its `uRange` and `vRange` (UsdGeomNurbsPatch: the
+/// parameters "over which the surface is actually defined", within the knots' domain),
+/// exactly: each range end is inserted as a knot to full multiplicity and what lies
+/// beyond it is dropped ([`NurbsSurface::restricted`]). The parameters do not change, so
+/// trim loops stay where they were. A range reaching beyond the knots' domain is clipped
+/// to it, with a note; one that misses the domain is an error.
+fn ranged(
+    prim: &Prim,
+    surface: NurbsSurface,
+    notes: &mut Vec<String>,
+) -> Result<NurbsSurface, ValueError> {
+    let domain = surface.domain();
+    let mut range = domain;
+    for (name, lo, hi) in [
+        ("uRange", &mut range.u0, &mut range.u1),
+        ("vRange", &mut range.v0, &mut range.v1),
+    ] {
+        let Some(r) = tuples((prim, name), 2)? else {
+            continue;
+        };
+        let (a, b) = (r[0], r[1]);
+        let (from, to) = (a.max(*lo), b.min(*hi));
+        // Written so that a NaN end is refused too.
+        let overlaps = from < to;
+        if !overlaps {
+            return Err(bad(
+                prim,
+                format!("{name} ({a}, {b}) does not overlap the knots' domain ({lo}, {hi})"),
+            ));
+        }
+        if (from, to) != (a, b) {
+            notes.push(format!(
+                "{}: {name} ({a}, {b}) reaches beyond the knots' domain ({lo}, {hi}); clipped to it",
+                prim.path()
+            ));
+        }
+        (*lo, *hi) = (from, to);
+    }
+    Ok(if range == domain {
+        surface
+    } else {
+        surface.restricted(range)
+    })
 }
 
 /// The `trimCurve:*` attributes as loops (see [`nurbs_patch`]).
@@ -262,16 +295,22 @@ fn signed_area(segments: &[TrimSegment]) -> f64 {
 
 /// A `Mesh`: its faces and how it is to be read.
 pub struct MeshRead {
-    pub geometry: Geometry,
+    /// `None` when every face is a hole.
+    pub geometry: Option<Geometry>,
     /// What the reading could not honour, one line each.
     pub notes: Vec<String>,
 }
 
 /// A `Mesh` as a Catmull–Clark cage (UsdGeomMesh's default `subdivisionScheme`), or as
 /// triangles (fans of its faces) for `none`. `bilinear` and `loop` are read as triangles,
-/// said in a note: the kernel has neither scheme. Creases and corners are said in a note,
-/// not honoured: the Catmull–Clark kernel has smooth interior edges and sharp boundaries
-/// only.
+/// said in a note: the kernel has neither scheme. The faces in `holeIndices` are not
+/// rendered: a cage keeps them, so they still shape their neighbours (OpenSubdiv's
+/// holes), and triangles drop them. Creases and corners are said in a note, not
+/// honoured: the Catmull–Clark kernel has smooth interior edges and `edgeOnly`
+/// boundaries. So is USD's default `interpolateBoundary = "edgeAndCorner"` where it
+/// differs, at a boundary vertex of one face (OpenSubdiv's `VTX_BOUNDARY_EDGE_AND_CORNER`
+/// makes it a sharp corner; `edgeOnly` keeps it smooth), and `none` on a mesh with a
+/// boundary.
 pub fn mesh(prim: &Prim) -> Result<MeshRead, ValueError> {
     let pts = required((prim, "points"), points((prim, "points"))?)?;
     let face_counts = required(
@@ -315,9 +354,29 @@ pub fn mesh(prim: &Prim) -> Result<MeshRead, ValueError> {
         faces.push(f);
         at += n;
     }
+    let holes = counts((prim, "holeIndices"))?.unwrap_or_default();
+    if let Some(&h) = holes.iter().find(|&&h| h >= faces.len()) {
+        return Err(bad(
+            prim,
+            format!("holeIndices: face {h} beyond the {} faces", faces.len()),
+        ));
+    }
     let scheme = token((prim, "subdivisionScheme"))?.unwrap_or_else(|| "catmullClark".into());
     let mut notes = Vec::new();
     let path = prim.path();
+    let mut is_hole = vec![false; faces.len()];
+    for &h in &holes {
+        is_hole[h] = true;
+    }
+    if is_hole.iter().all(|&h| h) {
+        notes.push(format!(
+            "{path}: every face is in holeIndices; nothing to render"
+        ));
+        return Ok(MeshRead {
+            geometry: None,
+            notes,
+        });
+    }
     if scheme == "catmullClark" {
         let mut sharp = Vec::new();
         for name in ["creaseIndices", "cornerIndices"] {
@@ -327,13 +386,15 @@ pub fn mesh(prim: &Prim) -> Result<MeshRead, ValueError> {
         }
         if !sharp.is_empty() {
             notes.push(format!(
-                "{path}: {} not honoured (the Catmull–Clark kernel has smooth interior edges and sharp boundaries only)",
+                "{path}: {} not honoured (the Catmull–Clark kernel has smooth interior edges and edgeOnly boundaries)",
                 sharp.join(" and ")
             ));
         }
-        let cage = SubdivisionSurface::new(pts, faces).map_err(|e| bad(prim, e))?;
+        notes.extend(boundary_note(prim, &faces, pts.len())?);
+        let holes = holes.iter().map(|&h| h as u32).collect();
+        let cage = SubdivisionSurface::with_holes(pts, faces, holes).map_err(|e| bad(prim, e))?;
         return Ok(MeshRead {
-            geometry: Geometry::Subdivision(cage),
+            geometry: Some(Geometry::Subdivision(cage)),
             notes,
         });
     }
@@ -344,15 +405,58 @@ pub fn mesh(prim: &Prim) -> Result<MeshRead, ValueError> {
     }
     let triangles = faces
         .iter()
-        .flat_map(|f| (1..f.len() - 1).map(move |k| [f[0], f[k], f[k + 1]]))
+        .zip(&is_hole)
+        .filter(|(_, hole)| !**hole)
+        .flat_map(|(f, _)| (1..f.len() - 1).map(move |k| [f[0], f[k], f[k + 1]]))
         .collect();
     Ok(MeshRead {
-        geometry: Geometry::Mesh(TriangleMesh {
+        geometry: Some(Geometry::Mesh(TriangleMesh {
             positions: pts,
             normals: Vec::new(),
             indices: triangles,
-        }),
+        })),
         notes,
+    })
+}
+
+/// What `interpolateBoundary` asks of the cage's boundary that the kernel's `edgeOnly`
+/// rule does not give, if anything: sharp corners at the boundary vertices of one face
+/// under `edgeAndCorner` (the fallback), no boundary faces under `none`.
+fn boundary_note(
+    prim: &Prim,
+    faces: &[Vec<u32>],
+    points: usize,
+) -> Result<Option<String>, ValueError> {
+    let rule = token((prim, "interpolateBoundary"))?.unwrap_or_else(|| "edgeAndCorner".into());
+    let path = prim.path();
+    Ok(match rule.as_str() {
+        "edgeAndCorner" => {
+            let mut faces_at = vec![0usize; points];
+            for &v in faces.iter().flatten() {
+                faces_at[v as usize] += 1;
+            }
+            let corners = faces_at.iter().filter(|&&n| n == 1).count();
+            (corners > 0).then(|| {
+                format!(
+                    "{path}: interpolateBoundary \"edgeAndCorner\" not honoured at {corners} boundary corner vertices (read as edgeOnly: smooth, not sharp, corners)"
+                )
+            })
+        }
+        "none" => {
+            let mut edges: HashMap<(u32, u32), usize> = HashMap::new();
+            for f in faces {
+                for (k, &v) in f.iter().enumerate() {
+                    let w = f[(k + 1) % f.len()];
+                    *edges.entry((v.min(w), v.max(w))).or_default() += 1;
+                }
+            }
+            edges.values().any(|&n| n == 1).then(|| {
+                format!(
+                    "{path}: interpolateBoundary \"none\" not honoured (read as edgeOnly: the boundary faces are rendered)"
+                )
+            })
+        }
+        _ => None,
     })
 }
 

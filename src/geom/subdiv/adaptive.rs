@@ -100,17 +100,24 @@ impl Output {
     }
 }
 
-/// All patches of the cage's limit surface, and where each lies.
-pub fn build(cage: &Mesh) -> (Vec<BezierPatch>, Vec<Piece>, Stats) {
+/// All patches of the cage's limit surface but those of the faces `holes` (ascending),
+/// and where each lies. A hole's quads are never targets, so nothing is emitted or
+/// refined for them; they stay in every level's mesh, where they shape their neighbours.
+pub fn build(cage: &Mesh, holes: &[u32]) -> (Vec<BezierPatch>, Vec<Piece>, Stats) {
     let topo = Topology::new(cage);
     let all: Vec<u32> = (0..cage.faces.len() as u32).collect();
     let first = refine(cage, &topo, &all);
     let count = first.mesh.faces.len();
     let points = first.mesh.points.len();
+    let mut pieces: Vec<Option<Piece>> = (0..count as u32).map(|f| Some(Piece::whole(f))).collect();
+    for &f in holes {
+        let start = first.first_child[f as usize] as usize;
+        pieces[start..start + cage.faces[f as usize].len()].fill(None);
+    }
     let mut level = Level {
         mesh: first.mesh,
         depth: 1,
-        pieces: (0..count as u32).map(|f| Some(Piece::whole(f))).collect(),
+        pieces,
         limits: vec![None; points],
     };
     let mut out = Output {
@@ -118,6 +125,7 @@ pub fn build(cage: &Mesh) -> (Vec<BezierPatch>, Vec<Piece>, Stats) {
         pieces: Vec::new(),
         stats: Stats {
             cage_faces: cage.faces.len(),
+            holes: holes.len(),
             faces: count,
             ..Stats::default()
         },

@@ -9,6 +9,10 @@
 //! - [`adaptive`]: regular faces as Bézier patches, faces with an extraordinary vertex
 //!   refined into regular children down to the kernel's precision.
 //!
+//! Holes (OpenSubdiv's hole tags, USD's `holeIndices`): a cage face marked as a hole has
+//! no limit patch, but its points still shape its neighbours' limit surface, which is
+//! the same as without the hole.
+//!
 //! Parameterisation (the `trace` contract's `patch`, `u`, `v`): after the first step every
 //! face of the cage with n corners has become n quads; they are numbered in cage face
 //! order, corner by corner (face f's quad at its corner i is number `Σ_{g<f} n_g + i`).
@@ -98,6 +102,8 @@ impl Piece {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Stats {
     pub cage_faces: usize,
+    /// Cage faces that are holes.
+    pub holes: usize,
     /// Quads after the first step.
     pub faces: usize,
     /// Regular Bézier patches (whole quads and regular children).
@@ -114,6 +120,8 @@ pub struct Stats {
 #[derive(Clone, Debug, PartialEq)]
 pub struct SubdivisionSurface {
     pub cage: Mesh,
+    /// Cage faces without a limit patch, ascending.
+    pub holes: Vec<u32>,
     pub patches: Vec<BezierPatch>,
     pub pieces: Vec<Piece>,
     pub stats: Stats,
@@ -121,14 +129,34 @@ pub struct SubdivisionSurface {
 
 impl SubdivisionSurface {
     pub fn new(points: Vec<DVec3>, faces: Vec<Vec<u32>>) -> Result<Self, CageError> {
-        Ok(Self::from_cage(Mesh::cage(points, faces)?))
+        Self::with_holes(points, faces, Vec::new())
     }
 
-    fn from_cage(cage: Mesh) -> Self {
-        let (patches, pieces, mut stats) = adaptive::build(&cage);
+    /// The surface without the limit patches of the cage faces `holes` (indices into
+    /// `faces`, in any order, repeats allowed).
+    pub fn with_holes(
+        points: Vec<DVec3>,
+        faces: Vec<Vec<u32>>,
+        mut holes: Vec<u32>,
+    ) -> Result<Self, CageError> {
+        let count = faces.len();
+        if let Some(&face) = holes.iter().find(|&&f| f as usize >= count) {
+            return Err(CageError::BadHole {
+                face: face as usize,
+                count,
+            });
+        }
+        holes.sort_unstable();
+        holes.dedup();
+        Ok(Self::from_cage(Mesh::cage(points, faces)?, holes))
+    }
+
+    fn from_cage(cage: Mesh, holes: Vec<u32>) -> Self {
+        let (patches, pieces, mut stats) = adaptive::build(&cage, &holes);
         stats.levels = stats.levels.max(1);
         SubdivisionSurface {
             cage,
+            holes,
             patches,
             pieces,
             stats,
@@ -144,6 +172,7 @@ impl SubdivisionSurface {
                 faces: Vec::new(),
                 boundary: Default::default(),
             },
+            holes: Vec::new(),
             patches: Vec::new(),
             pieces,
             stats: Stats::default(),
@@ -156,7 +185,7 @@ impl SubdivisionSurface {
         for p in &mut cage.points {
             *p = m.transform_point3(*p);
         }
-        *self = Self::from_cage(cage);
+        *self = Self::from_cage(cage, std::mem::take(&mut self.holes));
     }
 
     /// The quad (after the first step) and its `(u, v)` for a hit at `(u, v)` on `patch`.

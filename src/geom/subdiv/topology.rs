@@ -57,6 +57,8 @@ pub enum CageError {
     NonManifoldVertex { vertex: usize, fans: usize },
     #[error("vertex {vertex} has a non-finite coordinate")]
     NonFinite { vertex: usize },
+    #[error("hole face {face} does not exist ({count} faces)")]
+    BadHole { face: usize, count: usize },
 }
 
 impl Mesh {
