@@ -13,7 +13,7 @@ pub(super) struct Cubes<T> {
     cells: HashMap<[i64; 3], Vec<T>>,
 }
 
-impl<T: Copy + Ord> Cubes<T> {
+impl<T: Copy> Cubes<T> {
     pub(super) fn new(cube: f64, origin: DVec3) -> Self {
         Cubes {
             cube,
@@ -42,21 +42,19 @@ impl<T: Copy + Ord> Cubes<T> {
         }
     }
 
-    /// The items filed in `p`'s cube and its 26 neighbours, each once, in order.
-    pub(super) fn near(&self, p: DVec3) -> Vec<T> {
+    /// Calls `visit` on the items filed in `p`'s cube and its 26 neighbours, an item once
+    /// per cube it is filed in: a caller that must see each item once filters the
+    /// candidates first and deduplicates the few left, rather than sorting them all.
+    pub(super) fn visit_near(&self, p: DVec3, mut visit: impl FnMut(T)) {
         let c = self.key(p);
-        let mut found = Vec::new();
         for dz in -1..=1 {
             for dy in -1..=1 {
                 for dx in -1..=1 {
                     if let Some(list) = self.cells.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
-                        found.extend(list.iter().copied());
+                        list.iter().for_each(|&item| visit(item));
                     }
                 }
             }
         }
-        found.sort_unstable();
-        found.dedup();
-        found
     }
 }

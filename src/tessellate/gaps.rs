@@ -106,16 +106,13 @@ impl<'a> SegmentGrid<'a> {
     /// cube and its neighbours.
     fn nearest_other(&self, p: DVec3, face: usize) -> Option<f64> {
         let mut best: Option<f64> = None;
-        for (f, l, s) in self
-            .cubes
-            .near(p)
-            .into_iter()
-            .filter(|e| e.0 as usize != face)
-        {
-            let line = &self.faces[f as usize][l as usize];
-            let d = distance_to_segment(p, line[s as usize], line[s as usize + 1]);
-            best = Some(best.map_or(d, |b| b.min(d)));
-        }
+        self.cubes.visit_near(p, |(f, l, s)| {
+            if f as usize != face {
+                let line = &self.faces[f as usize][l as usize];
+                let d = distance_to_segment(p, line[s as usize], line[s as usize + 1]);
+                best = Some(best.map_or(d, |b| b.min(d)));
+            }
+        });
         best
     }
 }

@@ -251,18 +251,27 @@ impl SegmentGrid {
         own: (usize, usize),
         eps: f64,
     ) -> Vec<((usize, usize), f64)> {
-        let candidates = self.cubes.near(p);
-        let mut best: Vec<((usize, usize), f64, f64)> = Vec::new();
-        for (f, k, s, Reach(reach)) in candidates {
+        // The segments within their reach of `p`, each once and in order (a segment is
+        // filed in several cubes): the cheap distance first, so that only the few left are
+        // sorted and searched along their exact curves.
+        let mut candidates = Vec::new();
+        self.cubes.visit_near(p, |c @ (f, k, s, Reach(reach))| {
             let piece = (f as usize, k as usize);
-            if piece == own {
-                continue;
+            if piece != own {
+                let line = &faces[piece.0].samples[piece.1];
+                let (a, b) = (line[s as usize].point, line[s as usize + 1].point);
+                if distance_to_segment(p, a, b) <= reach {
+                    candidates.push(c);
+                }
             }
+        });
+        candidates.sort_unstable();
+        candidates.dedup();
+        let mut best: Vec<((usize, usize), f64, f64)> = Vec::new();
+        for (f, k, s, _) in candidates {
+            let piece = (f as usize, k as usize);
             let line = &faces[piece.0].samples[piece.1];
             let (a, b) = (line[s as usize], line[s as usize + 1]);
-            if distance_to_segment(p, a.point, b.point) > reach {
-                continue;
-            }
             let (t, d) = nearest_on_curve(&faces[piece.0], piece.1, a.t, b.t, p);
             if d > eps {
                 continue;
