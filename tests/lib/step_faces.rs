@@ -749,3 +749,37 @@ fn catia_s_key_projects_its_edges_within_tolerance() {
     );
     assert!(m.report.far_edges.is_empty(), "{:?}", m.report.far_edges);
 }
+
+/// A sphere written as two faces, each bounded by the same two half circles from pole to
+/// pole (CATIA V4's primitives): one loop runs down the +x meridian and up the −x one,
+/// the other the same edges the other way round. By ISO 10303-42 face_bound each face lies
+/// to the left of its loop seen from outside, so the first is the hemisphere y > 0 and the
+/// second, whose `FACE_OUTER_BOUND` has the face on its right in the sphere's parameters,
+/// the hemisphere y < 0, not the first one again.
+#[test]
+fn two_faces_between_the_same_half_circles_are_the_two_hemispheres() {
+    for (first, side) in [(true, 1.0), (false, -1.0)] {
+        let mut w = StepWriter::default();
+        let ax = w.axis(DVec3::ZERO, DVec3::Z, DVec3::X);
+        let s = w.add(format!(
+            "SPHERICAL_SURFACE('',#{ax},{})",
+            step_support::real(1.0)
+        ));
+        let (north, south) = (w.vertex(DVec3::Z), w.vertex(-DVec3::Z));
+        // Both circles start at the north pole; the first passes +x, the second −x.
+        let c_plus = w.axis(DVec3::ZERO, DVec3::Y, DVec3::Z);
+        let c_plus = w.circle(c_plus, 1.0);
+        let c_minus = w.axis(DVec3::ZERO, -DVec3::Y, DVec3::Z);
+        let c_minus = w.circle(c_minus, 1.0);
+        let plus = w.edge(north, south, c_plus, true);
+        let minus = w.edge(north, south, c_minus, true);
+        let bound = if first {
+            w.bound(&[(plus, true), (minus, false)], true)
+        } else {
+            w.bound(&[(minus, true), (plus, false)], true)
+        };
+        w.face(&[bound], s);
+        let surface = only_surface(&read(&w.finish()));
+        assert_region(&surface, |p| (p.y.abs() > 0.05).then_some(p.y * side > 0.0));
+    }
+}

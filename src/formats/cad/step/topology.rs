@@ -623,9 +623,15 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
         hi.y = hi.y.min(std::f64::consts::FRAC_PI_2);
     }
     // Bounds that are all holes (each loop has the face on its right, ISO 10303-42
-    // face_bound, and none is the outer bound): the face is its closed surface with those
-    // holes cut out (a ball drilled through), so it spans the surface's natural range.
-    let all_holes = !face.bounds.iter().any(|b| b.outer && !b.edges.is_empty())
+    // face_bound): the face is its closed surface with those holes cut out (a ball drilled
+    // through), so it spans the surface's natural range. On an analytic closed surface a
+    // `FACE_OUTER_BOUND` is no exception: both sides of its loop are bounded, and the face
+    // is the one on the loop's left (a sphere written as two faces between the same two
+    // half circles, one loop each way round, is its two hemispheres). A B-spline's outer
+    // bound is kept as the outer loop: loops inverted onto a B-spline beside its poles can
+    // enclose their area the wrong way round (Alias writes such faces).
+    let outer_given = face.bounds.iter().any(|b| b.outer && !b.edges.is_empty());
+    let all_holes = !(outer_given && matches!(def, SurfaceDef::BSpline(_)))
         && loops
             .iter()
             .all(|l| l.1.is_none() && (signed_area(&l.0) > 0.0) != l.3);
