@@ -307,23 +307,8 @@ impl SegmentGrid {
 /// The parameter in `[t0, t1]` of piece `k` of `face` whose surface point is nearest `p`,
 /// and its distance: golden-section search (Kiefer 1953), the interval's ends included.
 fn nearest_on_curve(face: &Face, k: usize, t0: f64, t1: f64, p: DVec3) -> (f64, f64) {
-    let g = (5f64.sqrt() - 1.0) / 2.0;
     let f = |t: f64| (face.sample(k, t).point - p).length();
-    let (mut a, mut b) = (t0, t1);
-    let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..GOLDEN_STEPS {
-        if fc < fd {
-            (b, d, fd) = (d, c, fc);
-            c = b - g * (b - a);
-            fc = f(c);
-        } else {
-            (a, c, fc) = (c, d, fd);
-            d = a + g * (b - a);
-            fd = f(d);
-        }
-    }
-    let mid = 0.5 * (a + b);
+    let mid = crate::geom::golden::minimize(f, t0, t1, GOLDEN_STEPS);
     [(t0, f(t0)), (t1, f(t1)), (mid, f(mid))]
         .into_iter()
         .min_by(|x, y| x.1.total_cmp(&y.1))

@@ -107,7 +107,8 @@ impl Piece {
                     params[k.saturating_sub(1)],
                     params[(k + 1).min(params.len() - 1)],
                 );
-                let best = golden_max(&value, a, b).max(sign * points[k][axis]);
+                let t = crate::geom::golden::minimize(|t| -value(t), a, b, GOLDEN_STEPS);
+                let best = value(t).max(sign * points[k][axis]);
                 lo[axis] = lo[axis].min(sign * best);
                 hi[axis] = hi[axis].max(sign * best);
             }
@@ -143,23 +144,5 @@ impl Piece {
 /// at most two turning points per coordinate, which 16 samples separate.
 const SPAN_SAMPLES: usize = 16;
 
-/// The largest value of `f` on `[a, b]` (assumed to have one maximum there) by a
-/// golden-section search (Kiefer 1953) to 0.618⁶⁰ ≈ 3·10⁻¹³ of the interval.
-fn golden_max(f: &dyn Fn(f64) -> f64, a: f64, b: f64) -> f64 {
-    let g = (5f64.sqrt() - 1.0) / 2.0;
-    let (mut a, mut b) = (a.min(b), a.max(b));
-    let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..60 {
-        if fc > fd {
-            (b, d, fd) = (d, c, fc);
-            c = b - g * (b - a);
-            fc = f(c);
-        } else {
-            (a, c, fc) = (c, d, fd);
-            d = a + g * (b - a);
-            fd = f(d);
-        }
-    }
-    fc.max(fd)
-}
+/// Golden-section steps refining an extreme: 0.618⁶⁰ ≈ 3·10⁻¹³ of the bracket.
+const GOLDEN_STEPS: usize = 60;
