@@ -528,11 +528,13 @@ pub struct TessellateArgs {
     pub grid: Option<(u32, u32)>,
     /// Adaptive, crack-free tessellation with this chord-height tolerance (scene units):
     /// patch edges and trim curves are sampled until their chords are within it, and
-    /// trimmed faces are refined until the surface is within it at seven probes of every
-    /// triangle (the largest distance found is reported). Trimmed faces whose trim curves
-    /// meet within 10⁻⁴ of the model's size share their samples and vertices there, so a
-    /// closed solid's mesh is closed. For a Catmull–Clark cage the finest count any quad
-    /// needs, on every quad.
+    /// trimmed faces are refined until the surface is within 4/5 of it at thirteen probes
+    /// of every triangle (the largest distance found is reported). Trimmed faces whose trim
+    /// curves meet within 10⁻⁴ of the model's size share their samples and vertices there,
+    /// so a closed solid's mesh is closed. A trimmed face whose control points say it would
+    /// need more than 2^24 triangles (a damaged file, a tolerance far below the model) is
+    /// refused before any work. For a Catmull–Clark cage the finest count any quad needs,
+    /// on every quad.
     #[arg(long, value_name = "DISTANCE")]
     pub tolerance: Option<f64>,
     /// Print the report as JSON.

@@ -9,6 +9,7 @@
 pub mod bbox;
 pub mod bezier;
 pub mod bicubic;
+pub mod golden;
 pub mod interval;
 pub mod nurbs;
 pub mod pcurve;

@@ -78,6 +78,15 @@ pub enum TessellateError {
         triangles: u64,
         budget: u64,
     },
+    #[error(
+        "trimmed face {face} of object {object:?} would need about {triangles:.1e} triangles to lie within the tolerance (estimated from its control points before any work), above the budget of {budget} (2^24 triangles, about 1 GB with their vertices); its control points may be damaged, or use a larger --tolerance"
+    )]
+    Estimate {
+        object: String,
+        face: u32,
+        triangles: f64,
+        budget: u64,
+    },
 }
 
 /// Most triangles one tessellation may make: 2^24 (16.7 M), 12 bytes of indices each plus
@@ -96,7 +105,7 @@ pub struct TessellationReport {
     pub bytes: u64,
     pub trim_gaps: TrimGaps,
     /// The largest distance from a trimmed face's exact surface to its triangles, probed at
-    /// seven points of every triangle in the face's parameters (scene units).
+    /// thirteen points of every triangle in the face's parameters (scene units).
     pub surface_distance: f64,
     /// The largest distance of a vertex on an edge two trimmed faces share from a face's
     /// own surface point there (scene units): the vertex is one face's exact point, so this
@@ -236,6 +245,7 @@ pub fn tessellate_trimmed(
     for (k, s) in surfaces.iter().enumerate() {
         if let Some(region) = s.trim_region().ok().flatten()
             && let Some(face) = trimmed::Face::new(s, region, plan)
+                .map_err(|triangles| estimate_error("", faces.len(), triangles))?
         {
             index.push(k);
             faces.push(face);
@@ -296,7 +306,11 @@ fn split_and_join(
             // Loops that fail to convert were refused at load; were one to get here, the
             // surface is drawn untrimmed, as the renderer does.
             match s.trim_region().ok().flatten() {
-                Some(region) => split.faces.extend(trimmed::Face::new(s, region, plan)),
+                Some(region) => split
+                    .faces
+                    .extend(trimmed::Face::new(s, region, plan).map_err(|triangles| {
+                        estimate_error(&object.name, split.faces.len(), triangles)
+                    })?),
                 None => match &s.geometry {
                     SurfaceGeometry::Bezier(p) => split.plain.push(p.clone()),
                     SurfaceGeometry::Nurbs(n) => split.plain.extend(n.to_bezier_patches()),
@@ -330,6 +344,16 @@ type FaceBoundary = Vec<Vec<DVec3>>;
 struct Budget<'a> {
     object: &'a str,
     triangles: u64,
+}
+
+/// The error for trimmed face `face` of `object`, estimated to need `triangles`.
+fn estimate_error(object: &str, face: usize, triangles: f64) -> TessellateError {
+    TessellateError::Estimate {
+        object: object.to_string(),
+        face: face as u32,
+        triangles,
+        budget: MAX_TRIANGLES,
+    }
 }
 
 /// [`tessellate_object`] within `budget`, without the gap measure, with the boundaries of

@@ -36,6 +36,18 @@ use crate::geom::segment::distance_to_segment;
 /// "minimum resolution").
 pub const EDGE_FRACTION: f64 = 1e-4;
 
+/// How near, as a fraction of the join distance, a sample of the other face must lie to
+/// the foot of a sample on the other face's curve for the two to be one point. Along an
+/// edge the two faces' samples are distinct points of one curve, often nearer each other
+/// than the join distance (a curve sampled densely where it turns, the ends of the
+/// monotone pieces each face splits its own parameter curve into); joined, each would move
+/// along the curve away from its own parameters, off its face's surface by up to the join
+/// distance. At 10⁻² of it (10⁻⁶ of the model, the readers' chord tolerance
+/// [`crate::formats::cad::CHORD_TOLERANCE`]) only samples that are one point are joined;
+/// otherwise the other face gains the sample at its foot, so both faces still have both
+/// samples at one position each.
+const ALONG_FRACTION: f64 = 1e-2;
+
 /// Golden-section steps for the nearest point of a trim curve: 0.618⁶⁰ ≈ 3·10⁻¹³ of the
 /// segment's parameter range, below `f64` resolution of any position along it.
 const GOLDEN_STEPS: usize = 60;
@@ -90,9 +102,12 @@ pub(super) fn join(faces: &mut [Face]) -> f64 {
         for ((g, m), t) in grid.nearest_curves(faces, p, (f, k), eps) {
             let line = &faces[g].samples[m];
             let j = line.partition_point(|s| s.t < t);
+            let foot = faces[g].sample(m, t).point;
             let existing = [j.wrapping_sub(1), j]
                 .into_iter()
-                .filter(|&x| x < line.len() && (line[x].point - p).length() <= eps)
+                .filter(|&x| {
+                    x < line.len() && (line[x].point - foot).length() <= eps * ALONG_FRACTION
+                })
                 .min_by(|&x, &y| {
                     (line[x].point - p)
                         .length()
@@ -282,30 +297,27 @@ impl SegmentGrid {
                 None => best.push((piece, t, d)),
             }
         }
-        best.into_iter().map(|(piece, t, _)| (piece, t)).collect()
+        // A foot at a piece's end, farther than one point, is where a sample lies beyond
+        // that piece along the face's loop: the piece next to it on the same face holds
+        // its foot inside, and only that one is the sample's place.
+        let tight = eps * ALONG_FRACTION;
+        let inside: Vec<usize> = best
+            .iter()
+            .filter(|e| e.1 > 0.0 && e.1 < 1.0)
+            .map(|e| e.0.0)
+            .collect();
+        best.into_iter()
+            .filter(|&((g, _), t, d)| t > 0.0 && t < 1.0 || d <= tight || !inside.contains(&g))
+            .map(|(piece, t, _)| (piece, t))
+            .collect()
     }
 }
 
 /// The parameter in `[t0, t1]` of piece `k` of `face` whose surface point is nearest `p`,
 /// and its distance: golden-section search (Kiefer 1953), the interval's ends included.
 fn nearest_on_curve(face: &Face, k: usize, t0: f64, t1: f64, p: DVec3) -> (f64, f64) {
-    let g = (5f64.sqrt() - 1.0) / 2.0;
     let f = |t: f64| (face.sample(k, t).point - p).length();
-    let (mut a, mut b) = (t0, t1);
-    let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..GOLDEN_STEPS {
-        if fc < fd {
-            (b, d, fd) = (d, c, fc);
-            c = b - g * (b - a);
-            fc = f(c);
-        } else {
-            (a, c, fc) = (c, d, fd);
-            d = a + g * (b - a);
-            fd = f(d);
-        }
-    }
-    let mid = 0.5 * (a + b);
+    let mid = crate::geom::golden::minimize(f, t0, t1, GOLDEN_STEPS);
     [(t0, f(t0)), (t1, f(t1)), (mid, f(mid))]
         .into_iter()
         .min_by(|x, y| x.1.total_cmp(&y.1))

@@ -71,8 +71,16 @@ pub(super) struct TrimmedFace {
 
 /// Barycentric points at which a triangle's distance from the surface is probed: its
 /// centroid, the three points halfway from the centroid to a corner, and the edge
-/// midpoints (where the chord of a curved edge is farthest from it).
-const PROBES: [[f64; 3]; 7] = [
+/// midpoints and quarter points (the chord heights of [`CHORD_PROBES`]: along an edge
+/// over a span whose curvature changes, as a ruled B-spline strip's does, the chord is
+/// farthest from the surface off its middle).
+const PROBES: [[f64; 3]; 13] = [
+    [0.75, 0.25, 0.0],
+    [0.25, 0.75, 0.0],
+    [0.0, 0.75, 0.25],
+    [0.0, 0.25, 0.75],
+    [0.25, 0.0, 0.75],
+    [0.75, 0.0, 0.25],
     [1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0],
     [2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0],
     [1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0],
@@ -81,6 +89,12 @@ const PROBES: [[f64; 3]; 7] = [
     [0.0, 0.5, 0.5],
     [0.5, 0.0, 0.5],
 ];
+
+/// The fraction of the tolerance the probes are refined to: the probes sample each
+/// triangle, and between them the surface can lie a little farther from it (up to 5 %
+/// past the probes on a ruled B-spline strip at a 28-point lattice), so refining to
+/// 4/5 of the tolerance keeps the surface within the tolerance, not only the probes.
+const PROBED_FRACTION: f64 = 0.8;
 
 /// How near a grid point may come to a boundary edge, as a fraction of its patch's grid
 /// cell in each parameter: a quarter cell keeps the triangles between the loops and the
@@ -176,6 +190,46 @@ impl Patches {
     }
 }
 
+/// About how many triangles a patch needs for the surface to lie within `tolerance` of
+/// them: the uniform grid for which the error bound of linear interpolation,
+/// (h_u² M_uu + 2 h_u h_v M_uv + h_v² M_vv) / 8 over cells h_u × h_v (Ciarlet, "The Finite
+/// Element Method for Elliptic Problems", 1978, Theorem 3.1.6), is within it, with the
+/// second derivatives bounded by the control net's differences (Farin, "Curves and
+/// Surfaces for CAGD", §§5.3 and 16.4: M_uu ≤ p(p−1) max |Δ²_u P|, M_uv ≤ pq max
+/// |Δ_u Δ_v P|), from the Euclidean points of a rational net. Refinement stops well short
+/// of it on a fair surface; it is for telling, before any work, a face that no budget
+/// holds (a control point thrown 10¹⁸ out by a damaged file).
+fn refined_triangles(patch: &BezierPatch, tolerance: f64) -> f64 {
+    let (p, q) = (patch.degree_u(), patch.degree_v());
+    let at = |i: usize, j: usize| patch.point(i, j);
+    let (mut uu, mut uv, mut vv) = (0.0f64, 0.0f64, 0.0f64);
+    for j in 0..=q {
+        for i in 0..=p {
+            if i + 2 <= p {
+                uu = uu.max((at(i + 2, j) - 2.0 * at(i + 1, j) + at(i, j)).length());
+            }
+            if j + 2 <= q {
+                vv = vv.max((at(i, j + 2) - 2.0 * at(i, j + 1) + at(i, j)).length());
+            }
+            if i < p && j < q {
+                uv = uv.max((at(i + 1, j + 1) - at(i + 1, j) - at(i, j + 1) + at(i, j)).length());
+            }
+        }
+    }
+    let (p, q) = (p as f64, q as f64);
+    let (m_uu, m_uv, m_vv) = (p * (p - 1.0) * uu, p * q * uv, q * (q - 1.0) * vv);
+    // Cells per direction n_u, n_v with each term within a third of the tolerance.
+    let n_u = ((m_uu + m_uv) * 3.0 / (8.0 * tolerance))
+        .sqrt()
+        .ceil()
+        .max(1.0);
+    let n_v = ((m_vv + m_uv) * 3.0 / (8.0 * tolerance))
+        .sqrt()
+        .ceil()
+        .max(1.0);
+    2.0 * n_u * n_v
+}
+
 /// The span of sorted breaks `b` (at least two) that holds `t`, the end spans beyond them.
 fn span(b: &[f64], t: f64) -> usize {
     b.partition_point(|&x| x <= t).clamp(1, b.len() - 1) - 1
@@ -216,10 +270,33 @@ pub(super) struct Face {
 }
 
 impl Face {
-    /// The face of `surface` cut by `region`, its loops sampled for `plan`; `None` when the
-    /// surface has no patches.
-    pub fn new(surface: &Surface, region: TrimRegion, plan: Plan) -> Option<Face> {
-        let patches = Patches::of(surface, plan)?;
+    /// The face of `surface` cut by `region`, its loops sampled for `plan`; `Ok(None)` when
+    /// the surface has no patches. The triangles the patches the trim keeps any of will
+    /// need are estimated before any work (their grids, and in adaptive mode
+    /// [`refined_triangles`]): where that passes [`MAX_TRIANGLES`] (a damaged control point
+    /// far out, a tolerance far below the face's size), the face is refused with the
+    /// estimate (`Err`), before the time and memory are spent.
+    pub fn new(surface: &Surface, region: TrimRegion, plan: Plan) -> Result<Option<Face>, f64> {
+        let Some(patches) = Patches::of(surface, plan) else {
+            return Ok(None);
+        };
+        let estimate: f64 = patches
+            .list
+            .iter()
+            .filter(|(_, coverage)| *coverage != Coverage::Outside)
+            .map(|(patch, _)| {
+                let (gu, gv) = grid(patch, plan);
+                let refined = match plan {
+                    Plan::Adaptive { tolerance } => refined_triangles(patch, tolerance),
+                    Plan::Uniform { .. } => 0.0,
+                };
+                (2.0 * gu as f64 * gv as f64).max(refined)
+            })
+            .sum();
+        // NaN (a control point at infinity) is refused too.
+        if estimate.is_nan() || estimate > MAX_TRIANGLES as f64 {
+            return Err(estimate);
+        }
         let mut grid_points = Vec::new();
         for (patch, coverage) in &patches.list {
             if *coverage == Coverage::Outside {
@@ -278,7 +355,7 @@ impl Face {
         face.samples = (0..face.curves.len())
             .map(|k| face.sample_piece(k, plan))
             .collect();
-        Some(face)
+        Ok(Some(face))
     }
 
     /// The sample of piece `k` at `t`. The ends are the piece's end points themselves, so
@@ -409,9 +486,10 @@ impl Face {
                 let (d, worst) = self.probe(t, &points.list, &positions, &constraints);
                 deviation = deviation.max(d);
                 if let (Plan::Adaptive { tolerance }, Some((far, q))) = (plan, worst)
-                    && far > tolerance
+                    && far > tolerance * PROBED_FRACTION
                 {
-                    refine.push(q);
+                    let centroid = t.map(|i| points.list[i as usize]).iter().sum::<DVec2>() / 3.0;
+                    refine.push((q, centroid));
                 }
             }
             if refine.is_empty() || rounds == MAX_REFINE_ROUNDS {
@@ -425,12 +503,17 @@ impl Face {
                     positions,
                 ));
             }
-            for q in refine {
-                let before = points.list.len();
-                let i = points.add(q);
-                if i as usize == before {
-                    positions.push(self.patches.eval(q));
-                    insert(&mut cdt, q)?;
+            for (q, centroid) in refine {
+                // A probe that is a point already (the midpoint of an edge that rounding
+                // kept beside the point made there) would stall the refinement: the
+                // triangle's centroid is taken instead.
+                for p in [q, centroid] {
+                    let before = points.list.len();
+                    if points.add(p) as usize == before {
+                        positions.push(self.patches.eval(p));
+                        insert(&mut cdt, p)?;
+                        break;
+                    }
                 }
             }
             rounds += 1;

@@ -44,3 +44,34 @@ fn the_hammer_tessellates_with_its_trims_and_reports_the_gaps() {
     ]);
     assert!(stdout(&o).contains("trim gaps: largest"), "{}", stdout(&o));
 }
+
+/// A damaged file: the holed plate of `testdata/holed_plate.obj` with one control point of
+/// its plate moved to 9·10¹⁸ (a bilinear patch twisted that far needs some 10²⁰ triangles
+/// at 0.05). The estimate made before any work refuses the face, naming it, with exit 2
+/// and no file written; before it, the refinement ran for minutes and wrote 1.3 M
+/// triangles as far as 10¹⁷ from the surface.
+#[test]
+fn a_control_point_thrown_far_out_is_refused_before_the_work() {
+    let plate = std::fs::read_to_string(common::testdata("holed_plate.obj")).unwrap();
+    assert_eq!(plate.matches("\nv 4 2 0\n").count(), 1);
+    let damaged = plate.replace("\nv 4 2 0\n", "\nv 4 2 9e18\n");
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("damaged.obj");
+    std::fs::write(&input, damaged).unwrap();
+    let out = dir.path().join("damaged.stl");
+    let o = run(&[
+        "tessellate",
+        input.to_str().unwrap(),
+        "--tolerance",
+        "0.05",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(
+        e.contains("trimmed face 0 of object \"damaged.obj\"") && e.contains("e20 triangles"),
+        "{e}"
+    );
+    assert!(!out.exists());
+}

@@ -71,7 +71,7 @@ fn param_triangulation(surface: &Surface, mode: TessellationMode) -> ParamTriang
         object: "",
         triangles: MAX_TRIANGLES,
     };
-    let face = Face::new(surface, region, plan).unwrap();
+    let face = Face::new(surface, region, plan).unwrap().unwrap();
     face.triangulate(plan, budget, 0).unwrap().0
 }
 

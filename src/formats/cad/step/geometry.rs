@@ -30,26 +30,12 @@ pub fn closest_param(f: impl Fn(f64) -> DVec3, t0: f64, t1: f64, p: DVec3) -> f6
     let best = (0..=n)
         .min_by(|&a, &b| dist(at(a)).total_cmp(&dist(at(b))))
         .unwrap_or(0);
-    let (mut a, mut b) = (at(best.saturating_sub(1)), at((best + 1).min(n)));
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
-    let (mut fc, mut fd) = (dist(c), dist(d));
-    for _ in 0..GOLDEN_STEPS {
-        if fc < fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - g * (b - a);
-            fc = dist(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + g * (b - a);
-            fd = dist(d);
-        }
-    }
-    let t = 0.5 * (a + b);
+    let t = crate::geom::golden::minimize(
+        dist,
+        at(best.saturating_sub(1)),
+        at((best + 1).min(n)),
+        GOLDEN_STEPS,
+    );
     // The sampled ends are candidates too: the search only narrows an interior bracket.
     [t, t0, t1]
         .into_iter()

@@ -582,11 +582,10 @@ pub fn convert_face(face: &Face, scale: f64) -> Result<FaceOutcome, String> {
         let mut lo = f64::INFINITY;
         let mut hi = f64::NEG_INFINITY;
         for p in &pieces {
-            for q in p.samples() {
-                lo = lo.min(q.x);
-                hi = hi.max(q.x);
-                extent_points.push(q);
-            }
+            let [a, b] = p.extent();
+            lo = lo.min(a.x);
+            hi = hi.max(b.x);
+            extent_points.extend([a, b]);
         }
         if outer_u.is_none() {
             outer_u = Some((lo, hi));
