@@ -37,18 +37,22 @@ fn tessellate(s: &SubdivisionSurface, n: u32) -> TriangleMesh {
     }
 }
 
-/// Directed edges after welding identical positions: each must occur once, with its
-/// reverse once (a closed, consistently wound surface without cracks or T-junctions).
-fn assert_closed(name: &str, m: &TriangleMesh) {
+/// Each vertex's number after welding bit-identical positions.
+fn welded(m: &TriangleMesh) -> Vec<usize> {
     let mut weld: HashMap<[u64; 3], usize> = HashMap::new();
-    let ids: Vec<usize> = m
-        .positions
+    m.positions
         .iter()
         .map(|p| {
             let n = weld.len();
             *weld.entry(p.to_array().map(f64::to_bits)).or_insert(n)
         })
-        .collect();
+        .collect()
+}
+
+/// Directed edges after welding identical positions: each must occur once, with its
+/// reverse once (a closed, consistently wound surface without cracks or T-junctions).
+fn assert_closed(name: &str, m: &TriangleMesh) {
+    let ids = welded(m);
     let mut directed: HashMap<(usize, usize), usize> = HashMap::new();
     for t in &m.indices {
         let v = t.map(|i| ids[i as usize]);
@@ -199,15 +203,7 @@ fn a_hole_face_is_left_out_and_its_rim_is_the_only_boundary() {
     assert_eq!(s.stats.holes, 1);
     let m = tessellate(&s, 4);
     assert_eq!(m.indices.len(), 2 * 16 * 20);
-    let mut weld: HashMap<[u64; 3], usize> = HashMap::new();
-    let ids: Vec<usize> = m
-        .positions
-        .iter()
-        .map(|p| {
-            let n = weld.len();
-            *weld.entry(p.to_array().map(f64::to_bits)).or_insert(n)
-        })
-        .collect();
+    let ids = welded(m);
     let mut directed: HashMap<(usize, usize), usize> = HashMap::new();
     for t in &m.indices {
         let v = t.map(|i| ids[i as usize]);
