@@ -203,7 +203,7 @@ fn a_hole_face_is_left_out_and_its_rim_is_the_only_boundary() {
     assert_eq!(s.stats.holes, 1);
     let m = tessellate(&s, 4);
     assert_eq!(m.indices.len(), 2 * 16 * 20);
-    let ids = welded(m);
+    let ids = welded(&m);
     let mut directed: HashMap<(usize, usize), usize> = HashMap::new();
     for t in &m.indices {
         let v = t.map(|i| ids[i as usize]);
