@@ -55,11 +55,70 @@ pub fn parameters_near(s: &impl ParamSurface, p: DVec3, near: Option<DVec2>) -> 
 /// pole, a cone's apex, the degenerate edge of a closed B-spline): a quarter period along
 /// it moves the point by at most `tol`.
 pub fn collapsed(s: &impl ParamSurface, uv: DVec2, axis: usize, tol: f64) -> bool {
-    s.periods()[axis].is_some_and(|p| {
+    quarter_turn(s, uv, axis).is_some_and(|d| d <= tol)
+}
+
+/// How far a quarter period along the periodic parameter `axis` moves the point at `uv`
+/// (√2 times its distance from the axis of a surface of revolution); `None` where `axis`
+/// is not periodic.
+fn quarter_turn(s: &impl ParamSurface, uv: DVec2, axis: usize) -> Option<f64> {
+    s.periods()[axis].map(|p| {
         let mut step = DVec2::ZERO;
         step[axis] = 0.25 * p;
-        s.point(uv).distance(s.point(uv + step)) <= tol
+        s.point(uv).distance(s.point(uv + step))
     })
+}
+
+/// Gives the samples at a pole or apex, where the periodic parameter `axis` means nothing
+/// (its inversion there is rounding), the value of their neighbours along the curve. A
+/// run of such samples between two neighbours is split at the sample nearest the pole:
+/// those before it take the value the curve arrives with, those after the value it
+/// leaves with. Where the two differ the curve passes through the pole (a meridian run
+/// over it onto the opposite one), and the sample nearest the pole is doubled, so the
+/// polyline runs along the pole's line in the parameter plane from the one value to the
+/// other, as a pcurve through a pole does (ISO 10303-42 pcurve; a degenerate edge of a
+/// B-rep): a chord cutting across instead leaves the face a corner short and a spur
+/// doubling back along the far meridian, which readers of the faces we write reject.
+fn through_poles(
+    s: &impl ParamSurface,
+    ts: &mut Vec<f64>,
+    uvs: &mut Vec<DVec2>,
+    axis: usize,
+    tol: f64,
+) {
+    let mut k = 0;
+    while k < uvs.len() {
+        if !collapsed(s, uvs[k], axis, tol) {
+            k += 1;
+            continue;
+        }
+        let start = k;
+        while k < uvs.len() && collapsed(s, uvs[k], axis, tol) {
+            k += 1;
+        }
+        let (before, after) = (start.checked_sub(1), (k < uvs.len()).then_some(k));
+        let (arrive, leave) = match (before, after) {
+            (Some(b), Some(a)) => (uvs[b][axis], uvs[a][axis]),
+            (Some(j), None) | (None, Some(j)) => (uvs[j][axis], uvs[j][axis]),
+            (None, None) => continue,
+        };
+        let nearest = (start..k)
+            .min_by(|&a, &b| {
+                let d = |j: usize| quarter_turn(s, uvs[j], axis).unwrap_or(0.0);
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap_or(start);
+        for j in start..k {
+            uvs[j][axis] = if j <= nearest { arrive } else { leave };
+        }
+        if leave != arrive {
+            let mut turn = uvs[nearest];
+            turn[axis] = leave;
+            uvs.insert(nearest + 1, turn);
+            ts.insert(nearest + 1, ts[nearest]);
+            k += 1;
+        }
+    }
 }
 
 /// How closely a projection follows its curve, in model units.
@@ -129,20 +188,8 @@ pub fn project(
         ts.push(t);
         uvs.push(uv);
     }
-    // Samples at a pole take the periodic parameter of their neighbour along the curve
-    // (any value is the same point there; the neighbour's keeps the chords on the curve).
     for axis in 0..2 {
-        for k in 0..uvs.len() {
-            if collapsed(s, uvs[k], axis, tol.point) {
-                let next = (k + 1..uvs.len()).find(|&j| !collapsed(s, uvs[j], axis, tol.point));
-                let prev = (0..k)
-                    .rev()
-                    .find(|&j| !collapsed(s, uvs[j], axis, tol.point));
-                if let Some(j) = next.or(prev) {
-                    uvs[k][axis] = uvs[j][axis];
-                }
-            }
-        }
+        through_poles(s, &mut ts, &mut uvs, axis, tol.point);
     }
     // Refine: a stack of segments, left to right.
     let mut out = vec![uvs[0]];
@@ -152,6 +199,11 @@ pub fn project(
         .collect();
     let mut chord_worst: f64 = 0.0;
     while let Some((t0, a, t1, b, depth)) = stack.pop() {
+        if t0 == t1 {
+            // Along a pole's line (`through_poles`): one point of the curve.
+            out.push(b);
+            continue;
+        }
         let tm = 0.5 * (t0 + t1);
         let mut m = measure(tm, Some(a))?;
         for axis in 0..2 {

@@ -129,6 +129,50 @@ fn a_meridian_from_the_pole_keeps_its_longitude() {
     );
 }
 
+#[test]
+fn a_half_circle_through_the_pole_turns_along_the_pole_line() {
+    // The great half circle from the equator at u = π over the south pole to the equator
+    // at u = 0: in closed form its pcurve is the meridian u = π down to v = −π/2, the pole
+    // line from u = π to u = 0 (mod 2π), and the meridian u = 0 back up. Samples near the
+    // pole have no meaningful u; they must not give the polyline a chord cutting across
+    // the corner and a spur down the far meridian.
+    use std::f64::consts::{FRAC_PI_2, PI};
+    let half = |t: f64| DVec3::new(-t.cos(), 0.0, -t.sin());
+    for tol in [1e-9, 1e-4, 1e-3] {
+        let p = project(&Sphere, half, 0.0, PI, both(tol)).unwrap();
+        let turn = p
+            .points
+            .windows(2)
+            .position(|w| (w[1].x - w[0].x).abs() > 1.0)
+            .expect("the polyline crosses to the other meridian");
+        let (before, after) = p.points.split_at(turn + 1);
+        let on = |q: &DVec2, u: f64| (q.x - u).rem_euclid(TAU).min((u - q.x).rem_euclid(TAU));
+        for q in before {
+            assert!(on(q, PI) < 1e-12, "tol {tol}: {q} arrives off u = π");
+        }
+        for q in after {
+            assert!(on(q, 0.0) < 1e-12, "tol {tol}: {q} leaves off u = 0");
+        }
+        // The crossing runs along the pole's line, within the point tolerance of it.
+        let (a, b) = (before[before.len() - 1], after[0]);
+        assert_eq!(a.y, b.y, "tol {tol}: the crossing {a} -> {b} cuts across");
+        assert!(
+            Sphere.point(a).distance(DVec3::NEG_Z) <= tol.max(1e-12),
+            "tol {tol}: {a}"
+        );
+        // Latitude falls to the pole and rises after it: no spur doubling back.
+        assert!(
+            before.windows(2).all(|w| w[1].y < w[0].y),
+            "tol {tol}: {before:?}"
+        );
+        assert!(
+            after.windows(2).all(|w| w[1].y > w[0].y),
+            "tol {tol}: {after:?}"
+        );
+        assert!((a.y + FRAC_PI_2).abs() < 1e-3, "tol {tol}: {a}");
+    }
+}
+
 /// A long, thin, tapering tube whose rings are tilted against its axis, as CAD systems
 /// write a lofted rod: degree 1 along its length (u, clamped), and around it (v) an
 /// unclamped uniform closed cubic B-spline over `N` control points on a circle, domain
